@@ -1,0 +1,97 @@
+#ifndef knee_contact_active_set_h
+#define knee_contact_active_set_h
+
+#include <knee_contact/contact.h>
+#include <knee_contact/rigid_modes.h>
+
+#include <deal.II/base/parameter_handler.h>
+
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/sparse_matrix.h>
+#include <deal.II/lac/vector.h>
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace knee_contact
+{
+  using namespace dealii;
+
+  /**
+   * What the active-set loop found.
+   */
+  struct ContactSolution
+  {
+    std::vector<bool>   active;
+    std::vector<double> lambda; // contact force of each pair [N/m], >= 0
+    unsigned int        n_iterations = 0;
+    bool                converged    = true;
+    std::string         failure; // why not, if not converged
+    double              complementarity = 0;
+    double              max_penetration = 0; // max (A x - g)_p [m]
+  };
+
+
+
+  /**
+   * The primal-dual active set method of step-41/42 for the seed's QP
+   * min 1/2 x^T C x - x^T d subject to A x <= g (its eq. (13) and P_d).
+   * Each iteration imposes the active rows as AffineConstraints lines,
+   * solves with UMFPACK, recovers the multipliers from the residual
+   * d - C x of the unconstrained system, and updates
+   *   A = {p : lambda_p + c ((A x)_p - g_p) > 0}.
+   * deal.II has no contact solver for node pairs between bodies, so the
+   * loop is written here.
+   */
+  class ActiveSetSolver
+  {
+  public:
+    static void
+    declare_parameters(ParameterHandler &prm);
+
+    void
+    parse_parameters(ParameterHandler &prm, const double max_youngs_modulus);
+
+    /**
+     * Solve; @p matrix and @p rhs are the unconstrained C and d, and
+     * @p pattern must hold the entries of every condensed system. @p log
+     * receives one line per iteration.
+     */
+    ContactSolution
+    solve(const SparseMatrix<double>      &matrix,
+          const Vector<double>            &rhs,
+          const AffineConstraints<double> &base,
+          const std::vector<ContactPair>  &pairs,
+          const RigidModes                &rigid_modes,
+          Vector<double>                  &solution,
+          std::ostream                    &log) const;
+
+    /**
+     * The constraints of @p base plus the active rows of @p pairs, closed.
+     */
+    static void
+    make_constraints(const AffineConstraints<double> &base,
+                     const std::vector<ContactPair>  &pairs,
+                     const std::vector<bool>         &active,
+                     AffineConstraints<double>       &constraints);
+
+    /**
+     * The multipliers lambda_p of the active pairs from the residual
+     * r = d - C x: C0^T r = C0^T A^T lambda at the eliminated dofs, where C0
+     * maps free dofs to all under Gamma_u/Gamma_o.
+     */
+    static std::vector<double>
+    multipliers(const Vector<double>            &residual,
+                const AffineConstraints<double> &base,
+                const std::vector<ContactPair>  &pairs,
+                const std::vector<bool>         &active);
+
+  private:
+    unsigned int max_iterations = 50;
+    double       c              = 0;
+    double       tolerance      = 1e-10;
+  };
+} // namespace knee_contact
+
+#endif

@@ -1,0 +1,83 @@
+#ifndef knee_contact_boundary_conditions_h
+#define knee_contact_boundary_conditions_h
+
+#include <deal.II/base/function_parser.h>
+#include <deal.II/base/parameter_handler.h>
+
+#include <deal.II/lac/affine_constraints.h>
+
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/fe/component_mask.h>
+
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace knee_contact
+{
+  using namespace dealii;
+
+  /**
+   * The seed's boundary parts (its eqs. (2)-(3)) by boundary id:
+   * Gamma_u (prescribed displacement u0, some components may be left
+   * free), Gamma_tau (traction P, or a pressure p along the inward normal)
+   * and Gamma_o (sliding: u.n = 0 and zero tangential traction).
+   */
+  enum class BoundaryType
+  {
+    displacement,
+    traction,
+    pressure,
+    sliding
+  };
+
+  struct BoundaryCondition
+  {
+    std::string                        name;
+    BoundaryType                       type = BoundaryType::displacement;
+    std::set<types::boundary_id>       ids;
+    ComponentMask                      mask;
+    std::unique_ptr<FunctionParser<2>> function;
+  };
+
+
+
+  class BoundaryConditions
+  {
+  public:
+    static void
+    declare_parameters(ParameterHandler &prm, const unsigned int n_conditions);
+
+    void
+    parse_parameters(ParameterHandler &prm, const unsigned int n_conditions);
+
+    /**
+     * Throw if a boundary id named in the scene is missing from the mesh.
+     */
+    void
+    check_mesh(const Triangulation<2> &triangulation) const;
+
+    /**
+     * Constraints of Gamma_u and Gamma_o (the seed's eq. (13), first three
+     * lines). Gamma_o uses deal.II's no-normal-flux constraints, which
+     * rotate the constraint to the averaged vertex normal on slanted and
+     * curved boundaries. Where a vertex lies on Gamma_u and Gamma_o,
+     * Gamma_u wins.
+     */
+    void
+    make_constraints(const DoFHandler<2>       &dof_handler,
+                     AffineConstraints<double> &constraints) const;
+
+    const std::vector<BoundaryCondition> &
+    conditions() const
+    {
+      return list;
+    }
+
+  private:
+    std::vector<BoundaryCondition> list;
+  };
+} // namespace knee_contact
+
+#endif

@@ -1,0 +1,69 @@
+#ifndef knee_contact_input_h
+#define knee_contact_input_h
+
+#include <deal.II/base/function_parser.h>
+#include <deal.II/base/parameter_handler.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace knee_contact
+{
+  using namespace dealii;
+
+  /**
+   * Helpers for reading a scene: paths relative to the scene file, run-time
+   * expressions (u0, P, F, references) and list entries. Every error names
+   * the parameter it came from, so the program can print it on one line.
+   */
+  namespace input
+  {
+    /**
+     * Resolve @p path against the folder of @p scene_file unless it is
+     * absolute: ctest and users run the program from anywhere.
+     */
+    std::string
+    resolve_path(const std::string &path, const std::string &scene_file);
+
+    /**
+     * Parse @p expression with @p n_components components (separated by ';')
+     * in the variables x, y and the constants "pi" and @p constants
+     * ("name=value, ..."). Throws an ExcMessage that names @p parameter if the
+     * expression does not parse.
+     */
+    std::unique_ptr<FunctionParser<2>>
+    parse_expression(const std::string &expression,
+                     const unsigned int n_components,
+                     const std::string &parameter,
+                     const std::string &constants = "");
+
+    /**
+     * Evaluate a constant expression such as "sqrt(0.01*0.5/pi)".
+     */
+    double
+    evaluate_constant(const std::string &expression,
+                      const std::string &parameter);
+
+    /**
+     * Split "a; b; c" at @p separator and trim white space.
+     */
+    std::vector<std::string>
+    split(const std::string &text, const char separator);
+
+    /**
+     * A finite double from @p text, or an error naming @p parameter.
+     */
+    double
+    to_double(const std::string &text, const std::string &parameter);
+
+    /**
+     * Turn an exception's text into one line: deal.II's messages span many
+     * lines and carry a stack trace the user has no use for.
+     */
+    std::string
+    one_line(const std::string &text);
+  } // namespace input
+} // namespace knee_contact
+
+#endif

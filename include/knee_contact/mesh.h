@@ -1,0 +1,84 @@
+#ifndef knee_contact_mesh_h
+#define knee_contact_mesh_h
+
+#include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/point.h>
+
+#include <deal.II/grid/tria.h>
+
+#include <array>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace knee_contact
+{
+  using namespace dealii;
+
+  /**
+   * One Triangulation<2> holding all bodies: read from a Gmsh file (.geo is
+   * meshed by the gmsh program first) or generated from rectangles. Physical
+   * surfaces are material ids and physical curves boundary ids. Bodies that
+   * share vertices are bonded; bodies in contact must have distinct
+   * (possibly coincident) vertices on their interface.
+   */
+  class MeshInput
+  {
+  public:
+    static void
+    declare_parameters(ParameterHandler &prm);
+
+    void
+    parse_parameters(ParameterHandler &prm, const std::string &scene_file);
+
+    /**
+     * Build the coarse mesh, attach the circular manifolds and refine
+     * globally as asked.
+     */
+    void
+    create(Triangulation<2> &triangulation) const;
+
+  private:
+    struct Rectangle
+    {
+      Point<2>                          lower, upper;
+      unsigned int                      n_x = 1, n_y = 1;
+      types::material_id                material_id = 0;
+      unsigned int                      group       = 0;
+      std::array<types::boundary_id, 4> boundary_ids{}; // left right bottom top
+    };
+
+    void
+    read_gmsh(Triangulation<2> &triangulation) const;
+
+    void
+    make_rectangles(Triangulation<2> &triangulation) const;
+
+    enum class Source
+    {
+      rectangles,
+      file
+    };
+
+    Source                                 source = Source::rectangles;
+    std::string                            file;
+    std::string                            gmsh_arguments;
+    std::vector<Rectangle>                 rectangles;
+    double                                 rotation_degrees = 0;
+    unsigned int                           n_refinements    = 0;
+    std::map<types::boundary_id, Point<2>> circular_boundaries;
+  };
+
+
+
+  /**
+   * The body of each active cell (index by active_cell_index()): bodies are
+   * the connected sets of cells that share vertices. Numbered 0, 1, ... in the
+   * order of their first cell, so numbering is deterministic.
+   */
+  std::vector<unsigned int>
+  compute_body_ids(const Triangulation<2> &triangulation,
+                   unsigned int           &n_bodies);
+} // namespace knee_contact
+
+#endif

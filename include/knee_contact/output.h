@@ -1,0 +1,90 @@
+#ifndef knee_contact_output_h
+#define knee_contact_output_h
+
+#include <knee_contact/active_set.h>
+#include <knee_contact/contact.h>
+#include <knee_contact/materials.h>
+#include <knee_contact/results.h>
+
+#include <deal.II/base/parameter_handler.h>
+
+#include <deal.II/lac/vector.h>
+
+#include <deal.II/dofs/dof_handler.h>
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace knee_contact
+{
+  using namespace dealii;
+
+  /**
+   * The files of a run, in the output folder: solution.vtu, one
+   * contact_<interface>.csv per interface and summary.json. Each file is
+   * written to a temporary name and renamed, so a run that fails never
+   * leaves a half-written file over a good one.
+   */
+  class OutputWriter
+  {
+  public:
+    static void
+    declare_parameters(ParameterHandler &prm);
+
+    void
+    parse_parameters(ParameterHandler &prm, const std::string &scene_file);
+
+    /** Create the folder; throw a one-line error if it cannot be written. */
+    void
+    prepare() const;
+
+    void
+    write_vtu(const DoFHandler<2>             &dof_handler,
+              const std::vector<unsigned int> &body_of_cell,
+              const Vector<double>            &solution,
+              const Materials                 &materials,
+              const std::vector<ContactPair>  &pairs,
+              const ContactSolution           &contact,
+              const Results                   &results) const;
+
+    void
+    write_contact_csv(const ContactInterfaces        &interfaces,
+                      const std::vector<ContactPair> &pairs,
+                      const Vector<double>           &solution,
+                      const ContactSolution          &contact,
+                      const Results                  &results) const;
+
+    void
+    write_summary(const Results                       &results,
+                  const ContactSolution               &contact,
+                  const Materials                     &materials,
+                  const std::map<std::string, double> &wall_times) const;
+
+    bool
+    test_mode() const
+    {
+      return terminal_test;
+    }
+
+    const std::string &
+    folder() const
+    {
+      return output_folder;
+    }
+
+    bool
+    enabled() const
+    {
+      return write_files;
+    }
+
+  private:
+    std::string output_folder;
+    double      magnification = 10;
+    bool        terminal_test = false;
+    bool        write_files   = true;
+  };
+} // namespace knee_contact
+
+#endif

@@ -1,0 +1,178 @@
+#ifndef knee_contact_problem_h
+#define knee_contact_problem_h
+
+#include <knee_contact/active_set.h>
+#include <knee_contact/boundary_conditions.h>
+#include <knee_contact/contact.h>
+#include <knee_contact/materials.h>
+#include <knee_contact/mesh.h>
+#include <knee_contact/output.h>
+#include <knee_contact/results.h>
+#include <knee_contact/verification.h>
+
+#include <deal.II/base/convergence_table.h>
+#include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/timer.h>
+
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/sparse_matrix.h>
+#include <deal.II/lac/sparsity_pattern.h>
+#include <deal.II/lac/vector.h>
+
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/fe/fe_system.h>
+#include <deal.II/grid/tria.h>
+
+#include <memory>
+#include <ostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace knee_contact
+{
+  using namespace dealii;
+
+  /**
+   * Exit codes of the program.
+   */
+  enum ExitCode : int
+  {
+    success             = 0,
+    input_error         = 1,
+    verification_failed = 2,
+    not_converged       = 3
+  };
+
+
+
+  /**
+   * The contact problem of the seed: s linear elastic bodies with
+   * Gamma_u, Gamma_tau, Gamma_o and unilateral contact on Gamma_c, solved
+   * on one or more meshes. It orchestrates: scene -> dofs and constraints
+   * -> assembled system -> active-set loop -> results -> files. Each step
+   * is done by the class of its concept.
+   */
+  class ContactProblem
+  {
+  public:
+    /**
+     * How many numbered subsections a scene file has; read in a first pass
+     * so that the second pass can declare exactly those.
+     */
+    struct Counts
+    {
+      unsigned int n_materials  = 1;
+      unsigned int n_conditions = 1;
+      unsigned int n_interfaces = 1;
+    };
+
+    static Counts
+    read_counts(const std::string &scene_file);
+
+    static void
+    declare_parameters(ParameterHandler &prm, const Counts &counts);
+
+    /**
+     * Read the scene file; throws a one-line message on bad input.
+     */
+    explicit ContactProblem(const std::string &scene_file);
+
+    /**
+     * Build the mesh and check it against the scene, without solving.
+     */
+    void
+    check_scene();
+
+    /**
+     * Solve on every refinement cycle, write the files of the last one,
+     * and return an ExitCode.
+     */
+    int
+    run();
+
+    // Access for unit tests.
+    const DoFHandler<2> &
+    dof_handler_of() const
+    {
+      return dof_handler;
+    }
+    const SparseMatrix<double> &
+    matrix() const
+    {
+      return system_matrix;
+    }
+    const Vector<double> &
+    rhs() const
+    {
+      return system_rhs;
+    }
+    const AffineConstraints<double> &
+    base_constraints() const
+    {
+      return constraints;
+    }
+    const std::vector<ContactPair> &
+    pairs() const
+    {
+      return contact_pairs;
+    }
+    const Vector<double> &
+    solution() const
+    {
+      return displacement;
+    }
+    const ContactSolution &
+    contact() const
+    {
+      return contact_solution;
+    }
+
+  private:
+    void
+    make_mesh();
+
+    void
+    setup_system();
+
+    std::ostream &
+    log() const;
+
+    /**
+     * The results table on the terminal; in test mode also the pressure
+     * profile of every interface.
+     */
+    void
+    print_results(const Results &results) const;
+
+    std::string scene_file;
+
+    MeshInput          mesh_input;
+    Materials          materials;
+    BoundaryConditions boundary_conditions;
+    ContactInterfaces  contact_interfaces;
+    ActiveSetSolver    active_set_solver;
+    OutputWriter       output_writer;
+    Verification       verification;
+    unsigned int       n_cycles = 1;
+
+    Triangulation<2>          triangulation;
+    FESystem<2>               fe;
+    DoFHandler<2>             dof_handler;
+    std::vector<unsigned int> body_of_cell;
+    unsigned int              n_bodies = 0;
+    std::vector<std::string>  body_names;
+
+    AffineConstraints<double> constraints;
+    std::vector<ContactPair>  contact_pairs;
+    SparsityPattern           sparsity_pattern;
+    SparseMatrix<double>      system_matrix;
+    Vector<double>            system_rhs;
+    Vector<double>            displacement;
+    ContactSolution           contact_solution;
+
+    mutable std::ostringstream quiet;
+  };
+} // namespace knee_contact
+
+#endif

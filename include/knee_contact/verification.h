@@ -1,0 +1,94 @@
+#ifndef knee_contact_verification_h
+#define knee_contact_verification_h
+
+#include <knee_contact/active_set.h>
+#include <knee_contact/contact.h>
+#include <knee_contact/materials.h>
+#include <knee_contact/results.h>
+
+#include <deal.II/base/function_parser.h>
+#include <deal.II/base/parameter_handler.h>
+
+#include <deal.II/lac/vector.h>
+
+#include <deal.II/dofs/dof_handler.h>
+
+#include <memory>
+#include <ostream>
+#include <vector>
+
+namespace knee_contact
+{
+  using namespace dealii;
+
+  /**
+   * Errors of one solution against the references a scene states.
+   * NaN where the scene gives no reference.
+   */
+  struct Errors
+  {
+    double l2_relative       = std::numeric_limits<double>::quiet_NaN();
+    double energy_relative   = std::numeric_limits<double>::quiet_NaN();
+    double nodal_relative    = std::numeric_limits<double>::quiet_NaN();
+    double stress_relative   = std::numeric_limits<double>::quiet_NaN();
+    double pressure_relative = std::numeric_limits<double>::quiet_NaN();
+  };
+
+
+
+  /**
+   * Checks of a solution against independent references stated in the
+   * scene's "Verification" subsection (exact fields, analytic values), and
+   * the KKT conditions of the contact problem. Each check prints one line
+   * "check <what>: <value> <= <tolerance>: PASS|FAIL".
+   */
+  class Verification
+  {
+  public:
+    static void
+    declare_parameters(ParameterHandler &prm);
+
+    void
+    parse_parameters(ParameterHandler &prm);
+
+    Errors
+    compute_errors(const DoFHandler<2>            &dof_handler,
+                   const Vector<double>           &solution,
+                   const Materials                &materials,
+                   const std::vector<ContactPair> &pairs,
+                   const Results                  &results) const;
+
+    /**
+     * Print the checks of the final cycle and of the convergence rates;
+     * return the number that failed.
+     */
+    unsigned int
+    check(const Results             &results,
+          const ContactSolution     &contact,
+          const bool                 has_contact,
+          const std::vector<Errors> &errors,
+          const std::vector<double> &n_dofs,
+          std::ostream              &out) const;
+
+    bool
+    has_exact_displacement() const
+    {
+      return exact_displacement != nullptr;
+    }
+
+  private:
+    std::unique_ptr<FunctionParser<2>> exact_displacement;
+    std::unique_ptr<FunctionParser<2>> exact_stress;
+    std::unique_ptr<FunctionParser<2>> exact_pressure;
+    double                             tolerance        = 1e-10;
+    double                             min_l2_rate      = 0;
+    double                             min_energy_rate  = 0;
+    bool                               check_kkt        = true;
+    double                             peak_pressure    = 0;
+    double                             peak_tolerance   = 0;
+    double                             contact_length   = 0;
+    double                             length_tolerance = 0;
+  };
+} // namespace knee_contact
+
+#endif

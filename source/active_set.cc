@@ -1,0 +1,266 @@
+#include <knee_contact/active_set.h>
+
+#include <deal.II/lac/dynamic_sparsity_pattern.h>
+#include <deal.II/lac/sparse_direct.h>
+#include <deal.II/lac/sparsity_pattern.h>
+
+#include <cmath>
+#include <iomanip>
+#include <map>
+#include <set>
+
+namespace knee_contact
+{
+  void
+  ActiveSetSolver::declare_parameters(ParameterHandler &prm)
+  {
+    prm.enter_subsection("Contact");
+    prm.declare_entry("Maximum active set iterations",
+                      "50",
+                      Patterns::Integer(1),
+                      "Stop with converged = false after this many "
+                      "iterations.");
+    prm.declare_entry("Active set constant",
+                      "100",
+                      Patterns::Double(0),
+                      "c of the active-set test lambda_p + c ((A x)_p - "
+                      "g_p) > 0, in units of the largest Young's modulus "
+                      "(step-42 uses 100 E).");
+    prm.declare_entry("Tolerance",
+                      "1e-10",
+                      Patterns::Double(0),
+                      "Converged when the active set repeats and the "
+                      "relative complementarity residual max_p |min(lambda_p "
+                      "/ max lambda, (g_p - (A x)_p) / max |u|)| is below "
+                      "this.");
+    prm.leave_subsection();
+  }
+
+
+
+  void
+  ActiveSetSolver::parse_parameters(ParameterHandler &prm,
+                                    const double      max_youngs_modulus)
+  {
+    prm.enter_subsection("Contact");
+    max_iterations = prm.get_integer("Maximum active set iterations");
+    c              = prm.get_double("Active set constant") * max_youngs_modulus;
+    tolerance      = prm.get_double("Tolerance");
+    AssertThrow(c > 0, ExcMessage("Contact/Active set constant must be > 0"));
+    prm.leave_subsection();
+  }
+
+
+
+  void
+  ActiveSetSolver::make_constraints(const AffineConstraints<double> &base,
+                                    const std::vector<ContactPair>  &pairs,
+                                    const std::vector<bool>         &active,
+                                    AffineConstraints<double> &constraints)
+  {
+    // An active row a'_p . x = g'_p over dofs free of Gamma_u/Gamma_o, solved
+    // for the eliminated dof j: x_j = (g'_p - sum_{k != j} a'_pk x_k) / a'_pj.
+    constraints.clear();
+    for (unsigned int p = 0; p < pairs.size(); ++p)
+      if (active[p])
+        {
+          const ContactPair &pair = pairs[p];
+          double             a_j  = 0;
+          for (const auto &[dof, a] : pair.reduced_row)
+            if (dof == pair.eliminated)
+              a_j = a;
+          constraints.add_line(pair.eliminated);
+          for (const auto &[dof, a] : pair.reduced_row)
+            if (dof != pair.eliminated)
+              constraints.add_entry(pair.eliminated, dof, -a / a_j);
+          constraints.set_inhomogeneity(pair.eliminated,
+                                        pair.reduced_gap / a_j);
+        }
+    constraints.merge(
+      base, AffineConstraints<double>::MergeConflictBehavior::left_object_wins);
+    constraints.close();
+  }
+
+
+
+  std::vector<double>
+  ActiveSetSolver::multipliers(const Vector<double>            &residual,
+                               const AffineConstraints<double> &base,
+                               const std::vector<ContactPair>  &pairs,
+                               const std::vector<bool>         &active)
+  {
+    // Equations at the eliminated dofs j_p of the active pairs:
+    //   sum_q lambda_q a'_q(j_p) = (C0^T r)(j_p),
+    // (C0^T r)(j) = r_j + sum over Gamma_u/Gamma_o lines x_i = c_ij x_j + ..
+    // of c_ij r_i. The matrix is the identity up to scaling unless rows
+    // share eliminated dofs, so this small sparse solve is cheap.
+    std::vector<unsigned int>                   index(pairs.size());
+    std::map<types::global_dof_index, unsigned> equation_of_dof;
+    unsigned int                                n = 0;
+    for (unsigned int p = 0; p < pairs.size(); ++p)
+      if (active[p])
+        {
+          index[p]                             = n;
+          equation_of_dof[pairs[p].eliminated] = n++;
+        }
+    std::vector<double> lambda(pairs.size(), 0.);
+    if (n == 0)
+      return lambda;
+
+    Vector<double> b(n);
+    for (const auto &[dof, e] : equation_of_dof)
+      b(e) = residual(dof);
+    for (const auto &line : base.get_lines())
+      for (const auto &[j, c] : line.entries)
+        {
+          const auto it = equation_of_dof.find(j);
+          if (it != equation_of_dof.end())
+            b(it->second) += c * residual(line.index);
+        }
+
+    DynamicSparsityPattern dsp(n, n);
+    for (unsigned int p = 0; p < pairs.size(); ++p)
+      if (active[p])
+        for (const auto &entry : pairs[p].reduced_row)
+          {
+            const auto it = equation_of_dof.find(entry.first);
+            if (it != equation_of_dof.end())
+              dsp.add(it->second, index[p]);
+          }
+    SparsityPattern sparsity;
+    sparsity.copy_from(dsp);
+    SparseMatrix<double> matrix(sparsity);
+    for (unsigned int p = 0; p < pairs.size(); ++p)
+      if (active[p])
+        for (const auto &[dof, a] : pairs[p].reduced_row)
+          {
+            const auto it = equation_of_dof.find(dof);
+            if (it != equation_of_dof.end())
+              matrix.add(it->second, index[p], a);
+          }
+    SparseDirectUMFPACK solver;
+    solver.initialize(matrix);
+    solver.solve(b);
+    for (unsigned int p = 0; p < pairs.size(); ++p)
+      if (active[p])
+        lambda[p] = b(index[p]);
+    return lambda;
+  }
+
+
+
+  ContactSolution
+  ActiveSetSolver::solve(const SparseMatrix<double>      &matrix,
+                         const Vector<double>            &rhs,
+                         const AffineConstraints<double> &base,
+                         const std::vector<ContactPair>  &pairs,
+                         const RigidModes                &rigid_modes,
+                         Vector<double>                  &solution,
+                         std::ostream                    &log) const
+  {
+    const unsigned int n_pairs = pairs.size();
+    ContactSolution    result;
+    // Start from the pairs that touch (g_p = 0): this holds a body that only
+    // contact holds (a floating femur) from the first solve on.
+    result.active.assign(n_pairs, false);
+    for (unsigned int p = 0; p < n_pairs; ++p)
+      result.active[p] =
+        pairs[p].eliminated != numbers::invalid_dof_index && pairs[p].gap <= 0;
+
+    std::set<std::vector<bool>> seen;
+    SparseMatrix<double>        system_matrix(matrix.get_sparsity_pattern());
+    Vector<double>              system_rhs(rhs.size());
+    Vector<double>              residual(rhs.size());
+    AffineConstraints<double>   constraints;
+    solution.reinit(rhs.size());
+
+    for (unsigned int iteration = 1;; ++iteration)
+      {
+        make_constraints(base, pairs, result.active, constraints);
+        rigid_modes.check(
+          base,
+          pairs,
+          result.active,
+          iteration == 1
+            ? "add a displacement or sliding boundary, or bring it into "
+              "contact (zero gap)"
+            : "at active-set iteration " + std::to_string(iteration) +
+                " its load pulls it off its contact pairs");
+
+        system_matrix.copy_from(matrix);
+        system_rhs = rhs;
+        constraints.condense(system_matrix, system_rhs);
+        SparseDirectUMFPACK direct;
+        direct.initialize(system_matrix);
+        direct.vmult(solution, system_rhs);
+        constraints.distribute(solution);
+
+        matrix.residual(residual, solution, rhs);
+        result.lambda = multipliers(residual, base, pairs, result.active);
+
+        // The active-set test of step-41, and the NCP residual
+        // |min(lambda_p, g_p - (A x)_p)| scaled by max lambda and max |u|.
+        double lambda_scale = 0;
+        for (const double l : result.lambda)
+          lambda_scale = std::max(lambda_scale, std::abs(l));
+        const double u_scale = std::max(solution.linfty_norm(), 1e-300);
+        if (lambda_scale == 0)
+          lambda_scale = 1;
+        std::vector<bool> next(n_pairs, false);
+        unsigned int      n_entered = 0, n_left = 0, n_active = 0;
+        result.complementarity = 0;
+        result.max_penetration = -std::numeric_limits<double>::max();
+        for (unsigned int p = 0; p < n_pairs; ++p)
+          {
+            const double excess    = pairs[p].jump(solution) - pairs[p].gap;
+            result.max_penetration = std::max(result.max_penetration, excess);
+            result.complementarity =
+              std::max(result.complementarity,
+                       std::abs(std::min(result.lambda[p] / lambda_scale,
+                                         -excess / u_scale)));
+            next[p] = pairs[p].eliminated != numbers::invalid_dof_index &&
+                      result.lambda[p] + c * excess > 0;
+            n_active += next[p];
+            n_entered += next[p] && !result.active[p];
+            n_left += !next[p] && result.active[p];
+          }
+        result.n_iterations = iteration;
+        log << "   active set iteration " << std::setw(2) << iteration << ": "
+            << std::setw(5) << n_active << " active pairs (+" << n_entered
+            << " -" << n_left << "), complementarity residual "
+            << std::scientific << std::setprecision(2) << result.complementarity
+            << std::defaultfloat << std::endl;
+
+        if (next == result.active && result.complementarity <= tolerance)
+          return result;
+        if (next == result.active)
+          {
+            result.converged = false;
+            result.failure   = "the active set settled but the "
+                               "complementarity residual stays above "
+                               "Contact/Tolerance";
+            return result;
+          }
+        if (seen.count(next))
+          {
+            result.converged = false;
+            result.failure =
+              "the active set cycles (iteration " + std::to_string(iteration) +
+              " returns to an earlier set); try a smaller 'Active set "
+              "constant' or a finer mesh at the contact";
+            return result;
+          }
+        if (iteration >= max_iterations)
+          {
+            result.converged = false;
+            result.failure =
+              "no convergence in " + std::to_string(max_iterations) +
+              " active-set iterations; raise 'Maximum active set "
+              "iterations' or refine the contact zone";
+            return result;
+          }
+        seen.insert(result.active);
+        result.active = next;
+      }
+  }
+} // namespace knee_contact

@@ -1,0 +1,156 @@
+#include <knee_contact/input.h>
+
+#include <deal.II/lac/vector.h>
+
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+namespace knee_contact
+{
+  namespace input
+  {
+    std::string
+    resolve_path(const std::string &path, const std::string &scene_file)
+    {
+      const std::filesystem::path p(path);
+      if (p.is_absolute() || path.empty())
+        return path;
+      return (std::filesystem::path(scene_file).parent_path() / p)
+        .lexically_normal()
+        .string();
+    }
+
+
+
+    std::vector<std::string>
+    split(const std::string &text, const char separator)
+    {
+      std::vector<std::string> parts;
+      std::string              part;
+      std::istringstream       in(text);
+      while (std::getline(in, part, separator))
+        parts.push_back(Utilities::trim(part));
+      if (!text.empty() && text.back() == separator)
+        parts.emplace_back();
+      return parts;
+    }
+
+
+
+    double
+    to_double(const std::string &text, const std::string &parameter)
+    {
+      double      value = 0;
+      std::size_t end   = 0;
+      try
+        {
+          value = std::stod(text, &end);
+        }
+      catch (...)
+        {
+          end = 0;
+        }
+      AssertThrow(end != 0 && Utilities::trim(text.substr(end)).empty() &&
+                    std::isfinite(value),
+                  ExcMessage("parameter '" + parameter + "': '" + text +
+                             "' is not a finite number"));
+      return value;
+    }
+
+
+
+    std::unique_ptr<FunctionParser<2>>
+    parse_expression(const std::string &expression,
+                     const unsigned int n_components,
+                     const std::string &parameter,
+                     const std::string &constants)
+    {
+      const auto parts = split(expression, ';');
+      AssertThrow(parts.size() == n_components,
+                  ExcMessage("parameter '" + parameter + "': expected " +
+                             std::to_string(n_components) +
+                             " component(s) separated by ';', got '" +
+                             expression + "'"));
+      std::map<std::string, double> constant_map = {{"pi", numbers::PI}};
+      for (const auto &c : split(constants, ','))
+        if (!c.empty())
+          {
+            const auto name_value = split(c, '=');
+            AssertThrow(name_value.size() == 2 && !name_value[0].empty(),
+                        ExcMessage("parameter '" + parameter + "': constant '" +
+                                   c + "' is not of the form name=value"));
+            constant_map[name_value[0]] =
+              to_double(name_value[1], parameter + " constants");
+          }
+
+      // The finite difference step only matters for gradients of reference
+      // solutions; a fourth order formula with h = 1e-4 keeps their error
+      // near 1e-13 for smooth fields.
+      auto function =
+        std::make_unique<FunctionParser<2>>(n_components, 0., 1e-4);
+      function->set_formula(AutoDerivativeFunction<2>::FourthOrder);
+      try
+        {
+          function->initialize("x,y", parts, constant_map);
+          Vector<double> values(n_components);
+          function->vector_value(Point<2>(0.123456789, 0.234567891), values);
+        }
+      catch (const std::exception &exc)
+        {
+          AssertThrow(false,
+                      ExcMessage("parameter '" + parameter +
+                                 "': cannot evaluate expression '" +
+                                 expression + "' (" + one_line(exc.what()) +
+                                 ")"));
+        }
+      return function;
+    }
+
+
+
+    double
+    evaluate_constant(const std::string &expression,
+                      const std::string &parameter)
+    {
+      const auto   function = parse_expression(expression, 1, parameter);
+      const double value    = function->value(Point<2>());
+      AssertThrow(std::isfinite(value),
+                  ExcMessage("parameter '" + parameter + "': '" + expression +
+                             "' is not finite"));
+      return value;
+    }
+
+
+
+    std::string
+    one_line(const std::string &text)
+    {
+      // deal.II's ExceptionBase::what() holds "Additional information:"
+      // followed by the message, then a stack trace; keep only the message.
+      std::string message = text;
+      const auto  info    = message.find("Additional information:");
+      if (info != std::string::npos)
+        message = message.substr(info + 23);
+      const auto trace = message.find("Stacktrace:");
+      if (trace != std::string::npos)
+        message = message.substr(0, trace);
+      std::string line;
+      bool        space = false;
+      for (const char c : message)
+        if (c == '\n' || c == '\t' || c == ' ' || c == '\r')
+          space = !line.empty();
+        else
+          {
+            if (space)
+              line += ' ';
+            line += c;
+            space = false;
+          }
+      // Strip a line of dashes deal.II adds around its messages.
+      while (!line.empty() && line.back() == '-')
+        line.pop_back();
+      return Utilities::trim(line);
+    }
+  } // namespace input
+} // namespace knee_contact

@@ -1,0 +1,73 @@
+#include <knee_contact/input.h>
+#include <knee_contact/problem.h>
+
+#include <deal.II/base/multithread_info.h>
+
+#include <cstring>
+#include <iostream>
+
+// knee_contact: unilateral contact between linear elastic bodies in 2D.
+// Usage: knee_contact [--dry-run] scene.prm | --help | --print-parameters
+int
+main(int argc, char **argv)
+{
+  using namespace knee_contact;
+  const std::string usage =
+    "usage: knee_contact SCENE.prm       solve the scene, results in its "
+    "output folder\n"
+    "       knee_contact --dry-run SCENE.prm  read the scene and build its "
+    "mesh, no solve\n"
+    "       knee_contact --print-parameters   every parameter with its "
+    "documentation and default\n"
+    "       knee_contact --help\n";
+  try
+    {
+      if (argc == 2 && (std::strcmp(argv[1], "--help") == 0 ||
+                        std::strcmp(argv[1], "-h") == 0))
+        {
+          std::cout << usage;
+          return ExitCode::success;
+        }
+      if (argc == 2 && std::strcmp(argv[1], "--print-parameters") == 0)
+        {
+          ParameterHandler prm;
+          ContactProblem::declare_parameters(prm, ContactProblem::Counts());
+          prm.print_parameters(std::cout, ParameterHandler::Text);
+          return ExitCode::success;
+        }
+      if (argc == 3 && std::strcmp(argv[1], "--dry-run") == 0)
+        {
+          ContactProblem problem(argv[2]);
+          problem.check_scene();
+          return ExitCode::success;
+        }
+      if (argc != 2 || argv[1][0] == '-')
+        {
+          std::cerr << "knee_contact: error: expected one scene file; see "
+                       "knee_contact --help"
+                    << std::endl;
+          return ExitCode::input_error;
+        }
+      ContactProblem problem(argv[1]);
+      return problem.run();
+    }
+  catch (const dealii::ExceptionBase &exc)
+    {
+      std::ostringstream info;
+      exc.print_info(info);
+      std::cerr << "knee_contact: error: " << input::one_line(info.str())
+                << std::endl;
+      return ExitCode::input_error;
+    }
+  catch (const std::exception &exc)
+    {
+      std::cerr << "knee_contact: error: " << input::one_line(exc.what())
+                << std::endl;
+      return ExitCode::input_error;
+    }
+  catch (...)
+    {
+      std::cerr << "knee_contact: error: unknown exception" << std::endl;
+      return ExitCode::input_error;
+    }
+}

@@ -1,0 +1,341 @@
+#include <knee_contact/input.h>
+#include <knee_contact/verification.h>
+
+#include <deal.II/base/quadrature_lib.h>
+
+#include <deal.II/fe/fe_values.h>
+
+#include <cmath>
+#include <iomanip>
+
+namespace knee_contact
+{
+  void
+  Verification::declare_parameters(ParameterHandler &prm)
+  {
+    prm.enter_subsection("Verification");
+    prm.declare_entry("Exact displacement",
+                      "",
+                      Patterns::Anything(),
+                      "Reference u = (u_x; u_y) [m] in x, y: L2, energy and "
+                      "nodal errors are reported. Empty: none.");
+    prm.declare_entry("Exact stress",
+                      "",
+                      Patterns::Anything(),
+                      "Reference (tau_xx; tau_yy; tau_xy) [Pa]: the maximum "
+                      "error at the cells' Gauss points relative to the "
+                      "largest reference stress is checked against "
+                      "Tolerance. Empty: none.");
+    prm.declare_entry("Exact contact pressure",
+                      "",
+                      Patterns::Anything(),
+                      "Reference contact pressure [Pa] at the slave vertices: "
+                      "the maximum error relative to its largest value is "
+                      "checked against Tolerance. Empty: none.");
+    prm.declare_entry("Tolerance",
+                      "1e-10",
+                      Patterns::Double(0),
+                      "Tolerance of the exact-field checks (relative); the "
+                      "nodal displacement error is checked too when an "
+                      "exact displacement is given and Minimum L2 rate is 0.");
+    prm.declare_entry("Minimum L2 rate",
+                      "0",
+                      Patterns::Double(0),
+                      "With several refinement cycles: the smallest allowed "
+                      "observed L2 rate after the first refinement (h ~ "
+                      "n_dofs^-1/2); 0: no check.");
+    prm.declare_entry("Minimum energy rate",
+                      "0",
+                      Patterns::Double(0),
+                      "The same for the energy norm error.");
+    prm.declare_entry("Check KKT",
+                      "true",
+                      Patterns::Bool(),
+                      "Check lambda >= 0, A x <= g (1e-10 of max |u|), "
+                      "complementarity and equilibrium (1e-8) when the scene "
+                      "has contact.");
+    prm.declare_entry("Reference peak pressure",
+                      "",
+                      Patterns::Anything(),
+                      "Constant expression for the expected largest contact "
+                      "pressure [Pa], e.g. a Hertz formula. Empty: none.");
+    prm.declare_entry("Peak pressure tolerance",
+                      "0.03",
+                      Patterns::Double(0),
+                      "Allowed relative error of the peak pressure.");
+    prm.declare_entry("Reference contact length",
+                      "",
+                      Patterns::Anything(),
+                      "Constant expression for the expected length of slave "
+                      "boundary in contact [m], summed over interfaces. "
+                      "Empty: none.");
+    prm.declare_entry("Contact length tolerance",
+                      "0",
+                      Patterns::Double(0),
+                      "Allowed absolute error of the contact length [m].");
+    prm.leave_subsection();
+  }
+
+
+
+  void
+  Verification::parse_parameters(ParameterHandler &prm)
+  {
+    prm.enter_subsection("Verification");
+    const auto optional = [&prm](const std::string &name,
+                                 const unsigned int n_components) {
+      const std::string text = prm.get(name);
+      return text.empty() ? nullptr
+                          : input::parse_expression(text,
+                                                    n_components,
+                                                    "Verification/" + name);
+    };
+    exact_displacement = optional("Exact displacement", 2);
+    exact_stress       = optional("Exact stress", 3);
+    exact_pressure     = optional("Exact contact pressure", 1);
+    tolerance          = prm.get_double("Tolerance");
+    min_l2_rate        = prm.get_double("Minimum L2 rate");
+    min_energy_rate    = prm.get_double("Minimum energy rate");
+    check_kkt          = prm.get_bool("Check KKT");
+    if (!prm.get("Reference peak pressure").empty())
+      peak_pressure =
+        input::evaluate_constant(prm.get("Reference peak pressure"),
+                                 "Verification/Reference peak pressure");
+    peak_tolerance = prm.get_double("Peak pressure tolerance");
+    if (!prm.get("Reference contact length").empty())
+      contact_length =
+        input::evaluate_constant(prm.get("Reference contact length"),
+                                 "Verification/Reference contact length");
+    length_tolerance = prm.get_double("Contact length tolerance");
+    prm.leave_subsection();
+  }
+
+
+
+  Errors
+  Verification::compute_errors(const DoFHandler<2>            &dof_handler,
+                               const Vector<double>           &solution,
+                               const Materials                &materials,
+                               const std::vector<ContactPair> &pairs,
+                               const Results                  &results) const
+  {
+    Errors errors;
+    if (exact_displacement || exact_stress)
+      {
+        // Errors in L2, in the energy norm a(e, e)^1/2 and of the stress at
+        // Gauss points; the exact gradient comes from fourth order
+        // differences of the expression.
+        FEValues<2>                        fe_values(dof_handler.get_fe(),
+                              QGauss<2>(3),
+                              update_values | update_gradients |
+                                update_quadrature_points | update_JxW_values);
+        const FEValuesExtractors::Vector   u(0);
+        const unsigned int                 n_q = fe_values.n_quadrature_points;
+        std::vector<Tensor<1, 2>>          values(n_q);
+        std::vector<SymmetricTensor<2, 2>> strains(n_q);
+        std::vector<Vector<double>>        exact_values(n_q, Vector<double>(2));
+        std::vector<std::vector<Tensor<1, 2>>> exact_gradients(
+          n_q, std::vector<Tensor<1, 2>>(2));
+        Vector<double> stress_values(3);
+        double         l2 = 0, l2_norm = 0, energy = 0, energy_norm = 0;
+        double         stress_error = 0, stress_max = 0;
+        for (const auto &cell : dof_handler.active_cell_iterators())
+          {
+            fe_values.reinit(cell);
+            fe_values[u].get_function_values(solution, values);
+            fe_values[u].get_function_symmetric_gradients(solution, strains);
+            const Material &material = materials[cell->material_id()];
+            if (exact_displacement)
+              {
+                exact_displacement->vector_value_list(
+                  fe_values.get_quadrature_points(), exact_values);
+                exact_displacement->vector_gradient_list(
+                  fe_values.get_quadrature_points(), exact_gradients);
+              }
+            for (unsigned int q = 0; q < n_q; ++q)
+              {
+                if (exact_displacement)
+                  {
+                    SymmetricTensor<2, 2> exact_strain;
+                    for (unsigned int i = 0; i < 2; ++i)
+                      for (unsigned int j = i; j < 2; ++j)
+                        exact_strain[i][j] = 0.5 * (exact_gradients[q][i][j] +
+                                                    exact_gradients[q][j][i]);
+                    Tensor<1, 2> exact;
+                    exact[0]                      = exact_values[q](0);
+                    exact[1]                      = exact_values[q](1);
+                    const SymmetricTensor<2, 2> e = strains[q] - exact_strain;
+                    l2 += (values[q] - exact).norm_square() * fe_values.JxW(q);
+                    l2_norm += exact.norm_square() * fe_values.JxW(q);
+                    energy += material.stress(e) * e * fe_values.JxW(q);
+                    energy_norm += material.stress(exact_strain) *
+                                   exact_strain * fe_values.JxW(q);
+                  }
+                if (exact_stress)
+                  {
+                    exact_stress->vector_value(fe_values.quadrature_point(q),
+                                               stress_values);
+                    const auto s = material.stress(strains[q]);
+                    stress_error =
+                      std::max({stress_error,
+                                std::abs(s[0][0] - stress_values(0)),
+                                std::abs(s[1][1] - stress_values(1)),
+                                std::abs(s[0][1] - stress_values(2))});
+                    stress_max = std::max({stress_max,
+                                           std::abs(stress_values(0)),
+                                           std::abs(stress_values(1)),
+                                           std::abs(stress_values(2))});
+                  }
+              }
+          }
+        if (exact_displacement)
+          {
+            errors.l2_relative     = std::sqrt(l2 / l2_norm);
+            errors.energy_relative = std::sqrt(energy / energy_norm);
+            // Nodal error at the vertices, relative to the largest value;
+            // the reference is evaluated a hair inside each cell, so that a
+            // reference that jumps between bodies in contact is taken from
+            // the vertex's own body.
+            double         nodal = 0, largest = 0;
+            Vector<double> exact(2);
+            for (const auto &cell : dof_handler.active_cell_iterators())
+              for (const unsigned int v : cell->vertex_indices())
+                {
+                  const Point<2> inside =
+                    cell->vertex(v) +
+                    1e-12 * (cell->center() - cell->vertex(v));
+                  exact_displacement->vector_value(inside, exact);
+                  for (unsigned int d = 0; d < 2; ++d)
+                    {
+                      nodal =
+                        std::max(nodal,
+                                 std::abs(
+                                   solution(cell->vertex_dof_index(v, d)) -
+                                   exact(d)));
+                      largest = std::max(largest, std::abs(exact(d)));
+                    }
+                }
+            errors.nodal_relative = nodal / largest;
+          }
+        if (exact_stress)
+          errors.stress_relative = stress_error / stress_max;
+      }
+    if (exact_pressure && !pairs.empty())
+      {
+        double error = 0, largest = 0;
+        for (unsigned int p = 0; p < pairs.size(); ++p)
+          {
+            const double exact = exact_pressure->value(pairs[p].position);
+            error   = std::max(error, std::abs(results.pressure[p] - exact));
+            largest = std::max(largest, std::abs(exact));
+          }
+        errors.pressure_relative = error / largest;
+      }
+    return errors;
+  }
+
+
+
+  unsigned int
+  Verification::check(const Results             &results,
+                      const ContactSolution     &contact,
+                      const bool                 has_contact,
+                      const std::vector<Errors> &errors,
+                      const std::vector<double> &n_dofs,
+                      std::ostream              &out) const
+  {
+    unsigned int n_failed = 0;
+    const auto   report   = [&](const std::string &what,
+                            const double       value,
+                            const std::string &relation,
+                            const double       bound) {
+      const bool pass =
+        relation == "<=" ? value <= bound : value >= bound; // NaN fails
+      out << "check " << what << ": " << std::scientific << std::setprecision(3)
+          << value << ' ' << relation << ' ' << bound << std::defaultfloat
+          << ": " << (pass ? "PASS" : "FAIL") << std::endl;
+      n_failed += pass ? 0 : 1;
+    };
+
+    const Errors &last = errors.back();
+    if (exact_displacement && min_l2_rate == 0 && min_energy_rate == 0)
+      report("relative nodal displacement error",
+             last.nodal_relative,
+             "<=",
+             tolerance);
+    if (exact_stress)
+      report("relative stress error", last.stress_relative, "<=", tolerance);
+    if (exact_pressure)
+      report("relative contact pressure error",
+             last.pressure_relative,
+             "<=",
+             tolerance);
+
+    // Observed rates between successive cycles, h ~ n_dofs^(-1/2).
+    const auto min_rate = [&](double Errors::*error) {
+      double rate = std::numeric_limits<double>::max();
+      for (unsigned int k = 2; k < errors.size(); ++k)
+        rate = std::min(rate,
+                        std::log(errors[k - 1].*error / errors[k].*error) /
+                          (0.5 * std::log(n_dofs[k] / n_dofs[k - 1])));
+      return rate;
+    };
+    if (min_l2_rate > 0)
+      report("smallest L2 rate after the first refinement",
+             min_rate(&Errors::l2_relative),
+             ">=",
+             min_l2_rate);
+    if (min_energy_rate > 0)
+      report("smallest energy rate after the first refinement",
+             min_rate(&Errors::energy_relative),
+             ">=",
+             min_energy_rate);
+
+    if (has_contact && check_kkt)
+      {
+        double max_pressure = 0, min_pressure = 0;
+        for (const double p : results.pressure)
+          {
+            max_pressure = std::max(max_pressure, p);
+            min_pressure = std::min(min_pressure, p);
+          }
+        report("converged", contact.converged ? 1 : 0, ">=", 1);
+        report("lambda >= 0: -min pressure / max pressure",
+               max_pressure > 0 ? -min_pressure / max_pressure : 0,
+               "<=",
+               1e-10);
+        report("A x <= g: max penetration / max |u|",
+               results.max_displacement > 0
+                 ? std::max(contact.max_penetration, 0.) /
+                     results.max_displacement
+                 : 0,
+               "<=",
+               1e-10);
+        report(
+          "complementarity residual", contact.complementarity, "<=", 1e-10);
+        report(
+          "equilibrium residual", results.equilibrium_residual, "<=", 1e-8);
+      }
+    if (peak_pressure != 0)
+      {
+        double max_pressure = 0;
+        for (const auto &i : results.interfaces)
+          max_pressure = std::max(max_pressure, i.max_pressure);
+        report("relative error of the peak pressure",
+               std::abs(max_pressure - peak_pressure) / peak_pressure,
+               "<=",
+               peak_tolerance);
+      }
+    if (contact_length != 0)
+      {
+        double length = 0;
+        for (const auto &i : results.interfaces)
+          length += i.contact_length;
+        report("error of the contact length [m]",
+               std::abs(length - contact_length),
+               "<=",
+               length_tolerance);
+      }
+    return n_failed;
+  }
+} // namespace knee_contact

@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Runs "knee_contact FILE" on a bad input and passes only if the program exits
+# non-zero without crashing (exit code < 128: no abort, no segfault), prints
+# exactly one line on stderr, and that line matches the regular expression on
+# FILE's first line ("# expect: <regex>").
+set -u
+program=$1
+file=$2
+regex=$(head -n 1 "$file" | sed -n 's/^# expect: //p')
+[ -n "$regex" ] || { echo "no '# expect: ' line in $file"; exit 1; }
+workdir=$(mktemp -d)
+trap 'rm -rf "$workdir"' EXIT
+cd "$workdir"
+"$program" "$file" >stdout 2>stderr
+code=$?
+echo "exit code $code; stderr:"
+cat stderr
+if [ $code -eq 0 ] || [ $code -ge 128 ]; then
+  echo "FAIL: expected a non-zero exit code below 128"
+  exit 1
+fi
+if [ "$(wc -l <stderr)" -ne 1 ]; then
+  echo "FAIL: expected exactly one line on stderr"
+  exit 1
+fi
+if ! grep -Eq -- "$regex" stderr; then
+  echo "FAIL: stderr does not match '$regex'"
+  exit 1
+fi
+echo PASS
