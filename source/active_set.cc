@@ -5,6 +5,7 @@
 #include <deal.II/lac/sparsity_pattern.h>
 
 #include <cmath>
+#include <limits>
 #include <iomanip>
 #include <map>
 #include <set>

@@ -151,12 +151,26 @@ namespace knee_contact
 
     AssertThrow(triangulation.n_active_cells() > 0,
                 ExcMessage("Mesh: the mesh has no cells"));
+    // The Jacobian of a bilinear quadrilateral is positive everywhere iff
+    // the cross products of the edges at all four corners are (deal.II's
+    // vertex order 0 1 3 2 runs counter-clockwise).
     for (const auto &cell : triangulation.active_cell_iterators())
-      AssertThrow(cell->measure() > 0,
-                  ExcMessage("Mesh: cell at (" +
-                             std::to_string(cell->center()[0]) + ", " +
-                             std::to_string(cell->center()[1]) +
-                             ") is inverted or degenerate"));
+      {
+        const unsigned int ring[4] = {0, 1, 3, 2};
+        for (unsigned int k = 0; k < 4; ++k)
+          {
+            const Tensor<1, 2> a =
+              cell->vertex(ring[(k + 1) % 4]) - cell->vertex(ring[k]);
+            const Tensor<1, 2> b =
+              cell->vertex(ring[(k + 3) % 4]) - cell->vertex(ring[k]);
+            AssertThrow(a[0] * b[1] - a[1] * b[0] >
+                          1e-12 * a.norm() * b.norm(),
+                        ExcMessage("Mesh: cell at (" +
+                                   std::to_string(cell->center()[0]) + ", " +
+                                   std::to_string(cell->center()[1]) +
+                                   ") is inverted, degenerate or not convex"));
+          }
+      }
 
     if (rotation_degrees != 0)
       GridTools::rotate(rotation_degrees * numbers::PI / 180, triangulation);
@@ -251,6 +265,15 @@ namespace knee_contact
                 ExcMessage("Mesh/File: '" + file +
                            "' has triangles; knee_contact needs "
                            "quadrilaterals (Recombine the surfaces)"));
+
+    // Gmsh orients the cells of a surface whose curve loop runs clockwise
+    // clockwise too, and GridIn keeps that; deal.II needs counter-clockwise
+    // cells, so rebuild the mesh with such cells turned over.
+    auto [vertices, cells, subcell_data] =
+      GridTools::get_coarse_mesh_description(triangulation);
+    GridTools::invert_all_negative_measure_cells(vertices, cells);
+    triangulation.clear();
+    triangulation.create_triangulation(vertices, cells, subcell_data);
   }
 
 

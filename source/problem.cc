@@ -10,6 +10,7 @@
 #include <deal.II/fe/fe_q.h>
 
 #include <filesystem>
+#include <map>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -176,18 +177,54 @@ namespace knee_contact
     boundary_conditions.make_constraints(dof_handler, constraints);
     contact_pairs = contact_interfaces.make_pairs(dof_handler, constraints);
 
-    // One sparsity pattern serves every active set: it holds the entries
-    // that condensing all contact rows at once would create.
+    // One sparsity pattern serves every active set. Condensing a subset of
+    // the contact lines couples each dof i with the dofs its line refers to,
+    // E(i), so an entry (i, j) of the mesh's pattern needs E(i) x E(j) for
+    // whichever of i, j are constrained; E(i) holds both the reduced row of
+    // a pair (partner lines inactive) and its fully resolved form (partners
+    // active), as well as the Gamma_u/Gamma_o entries.
     AffineConstraints<double> all_pairs;
-    ActiveSetSolver::make_constraints(constraints,
-                                      contact_pairs,
-                                      std::vector<bool>(contact_pairs.size(),
-                                                        true),
-                                      all_pairs);
-    // Pairs without an eliminated dof are never imposed.
+    ActiveSetSolver::make_constraints(
+      constraints,
+      contact_pairs,
+      std::vector<bool>(contact_pairs.size(), true),
+      all_pairs);
+    std::map<types::global_dof_index, std::vector<types::global_dof_index>>
+      expansion;
+    for (const auto &line : all_pairs.get_lines())
+      {
+        auto &e = expansion[line.index];
+        e.push_back(line.index);
+        for (const auto &entry : line.entries)
+          e.push_back(entry.first);
+      }
+    for (const auto &pair : contact_pairs)
+      if (pair.eliminated != numbers::invalid_dof_index)
+        for (const auto &entry : pair.reduced_row)
+          expansion[pair.eliminated].push_back(entry.first);
+
+    DynamicSparsityPattern mesh_pattern(dof_handler.n_dofs());
+    DoFTools::make_sparsity_pattern(dof_handler, mesh_pattern);
     DynamicSparsityPattern dsp(dof_handler.n_dofs());
-    DoFTools::make_sparsity_pattern(dof_handler, dsp);
-    all_pairs.condense(dsp);
+    for (types::global_dof_index i = 0; i < dof_handler.n_dofs(); ++i)
+      {
+        const auto ei = expansion.find(i);
+        for (auto it = mesh_pattern.begin(i); it != mesh_pattern.end(i); ++it)
+          {
+            const types::global_dof_index j  = it->column();
+            const auto                    ej = expansion.find(j);
+            if (ei == expansion.end() && ej == expansion.end())
+              dsp.add(i, j);
+            else
+              for (const auto a : ei == expansion.end() ?
+                                    std::vector<types::global_dof_index>{i} :
+                                    ei->second)
+                for (const auto b : ej == expansion.end() ?
+                                      std::vector<types::global_dof_index>{j} :
+                                      ej->second)
+                  dsp.add(a, b);
+          }
+      }
     sparsity_pattern.copy_from(dsp);
     system_matrix.reinit(sparsity_pattern);
   }

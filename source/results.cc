@@ -75,8 +75,13 @@ namespace knee_contact
                           counted[dof] = true;
                         }
                     }
+    // The force scale: the load, the reactions, or for a scene driven by
+    // prescribed displacements the force E max|u| that straining a body of
+    // unit size by max|u| takes.
     Tensor<1, 2> balance = results.applied_load;
-    double       scale   = results.applied_load.norm();
+    double       scale   = std::max(results.applied_load.norm(),
+                              materials.max_youngs_modulus() *
+                                results.max_displacement);
     for (const auto &reaction : results.reactions)
       {
         balance += reaction.second;
