@@ -6,8 +6,13 @@
 // subdivision into quadrilaterals halves both.
 Geometry.AutoCoherence = 0;
 R = 1;
-lc_fine = DefineNumber[0.01, Name "lc_fine"];
-lc_coarse = DefineNumber[0.2, Name "lc_coarse"];
+// Defaults; "gmsh -setnumber lc_fine 0.005" (Mesh/Gmsh arguments) overrides.
+If (!Exists(lc_fine))
+  lc_fine = 0.01;
+EndIf
+If (!Exists(lc_coarse))
+  lc_coarse = 0.2;
+EndIf
 
 Point(1) = {0, 0, 0};
 Point(2) = {R, R, 0};
