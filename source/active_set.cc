@@ -5,8 +5,8 @@
 #include <deal.II/lac/sparsity_pattern.h>
 
 #include <cmath>
-#include <limits>
 #include <iomanip>
+#include <limits>
 #include <map>
 #include <set>
 

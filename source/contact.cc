@@ -230,8 +230,8 @@ namespace knee_contact
                       s.position     = face->vertex(v);
                       s.normal += n; // length-weighted: |n| = face length
                       s.length += 0.5 * n.norm();
-                      s.dofs         = {{face->vertex_dof_index(v, 0),
-                                         face->vertex_dof_index(v, 1)}};
+                      s.dofs     = {{face->vertex_dof_index(v, 0),
+                                     face->vertex_dof_index(v, 1)}};
                       min_length = std::min(min_length, n.norm());
                     }
                 else if (face->boundary_id() == interface.master_id)

@@ -93,7 +93,7 @@ namespace knee_contact
       function->set_formula(AutoDerivativeFunction<2>::FourthOrder);
       // deal.II prints muparser's complaint to std::cerr before it throws;
       // silence that, the message below says it in one line.
-      std::ostringstream muparser_output;
+      std::ostringstream    muparser_output;
       std::streambuf *const cerr_buffer =
         std::cerr.rdbuf(muparser_output.rdbuf());
       try

@@ -163,8 +163,7 @@ namespace knee_contact
               cell->vertex(ring[(k + 1) % 4]) - cell->vertex(ring[k]);
             const Tensor<1, 2> b =
               cell->vertex(ring[(k + 3) % 4]) - cell->vertex(ring[k]);
-            AssertThrow(a[0] * b[1] - a[1] * b[0] >
-                          1e-12 * a.norm() * b.norm(),
+            AssertThrow(a[0] * b[1] - a[1] * b[0] > 1e-12 * a.norm() * b.norm(),
                         ExcMessage("Mesh: cell at (" +
                                    std::to_string(cell->center()[0]) + ", " +
                                    std::to_string(cell->center()[1]) +

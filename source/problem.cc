@@ -10,10 +10,10 @@
 #include <deal.II/fe/fe_q.h>
 
 #include <filesystem>
-#include <map>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <map>
 
 namespace knee_contact
 {
@@ -184,11 +184,11 @@ namespace knee_contact
     // a pair (partner lines inactive) and its fully resolved form (partners
     // active), as well as the Gamma_u/Gamma_o entries.
     AffineConstraints<double> all_pairs;
-    ActiveSetSolver::make_constraints(
-      constraints,
-      contact_pairs,
-      std::vector<bool>(contact_pairs.size(), true),
-      all_pairs);
+    ActiveSetSolver::make_constraints(constraints,
+                                      contact_pairs,
+                                      std::vector<bool>(contact_pairs.size(),
+                                                        true),
+                                      all_pairs);
     std::map<types::global_dof_index, std::vector<types::global_dof_index>>
       expansion;
     for (const auto &line : all_pairs.get_lines())
@@ -216,12 +216,12 @@ namespace knee_contact
             if (ei == expansion.end() && ej == expansion.end())
               dsp.add(i, j);
             else
-              for (const auto a : ei == expansion.end() ?
-                                    std::vector<types::global_dof_index>{i} :
-                                    ei->second)
-                for (const auto b : ej == expansion.end() ?
-                                      std::vector<types::global_dof_index>{j} :
-                                      ej->second)
+              for (const auto a : ei == expansion.end()
+                                    ? std::vector<types::global_dof_index>{i}
+                                    : ei->second)
+                for (const auto b : ej == expansion.end()
+                                      ? std::vector<types::global_dof_index>{j}
+                                      : ej->second)
                   dsp.add(a, b);
           }
       }

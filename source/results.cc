@@ -79,9 +79,9 @@ namespace knee_contact
     // prescribed displacements the force E max|u| that straining a body of
     // unit size by max|u| takes.
     Tensor<1, 2> balance = results.applied_load;
-    double       scale   = std::max(results.applied_load.norm(),
-                              materials.max_youngs_modulus() *
-                                results.max_displacement);
+    double       scale =
+      std::max(results.applied_load.norm(),
+               materials.max_youngs_modulus() * results.max_displacement);
     for (const auto &reaction : results.reactions)
       {
         balance += reaction.second;

@@ -22,11 +22,11 @@ main()
   ContactProblem problem(SOURCE_DIR "/qp_scene.prm");
   const int      status = problem.run();
 
-  const auto &K     = problem.matrix();
-  const auto &f     = problem.rhs();
-  const auto &base  = problem.base_constraints();
-  const auto &pairs = problem.pairs();
-  const unsigned int n = K.m();
+  const auto        &K     = problem.matrix();
+  const auto        &f     = problem.rhs();
+  const auto        &base  = problem.base_constraints();
+  const auto        &pairs = problem.pairs();
+  const unsigned int n     = K.m();
 
   // x = C0 z + g0 over the dofs free of Gamma_u.
   std::vector<unsigned int> free_index(n, numbers::invalid_unsigned_int);
@@ -118,7 +118,7 @@ main()
 
   Vector<double> difference(problem.solution());
   difference -= reference;
-  const double error = difference.linfty_norm() / reference.linfty_norm();
+  const double error    = difference.linfty_norm() / reference.linfty_norm();
   unsigned int pdas_set = 0;
   for (unsigned int p = 0; p < M; ++p)
     if (problem.contact().active[p])
