@@ -10,7 +10,7 @@ cd "$(dirname "$0")"
 # machinery; gmsh meshes .geo scenes; OpenBLAS makes UMFPACK 5-6x faster than
 # the reference BLAS; nlohmann-json writes summary.json with real numbers.
 packages="cmake make g++ libdeal.ii-dev numdiff perl openmpi-bin gmsh
-          libopenblas0-pthread nlohmann-json3-dev gnuplot-nox"
+          libopenblas0-pthread nlohmann-json3-dev python3-matplotlib"
 missing=""
 for package in $packages; do
   dpkg-query -W -f='${Status}' "$package" 2>/dev/null |

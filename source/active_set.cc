@@ -4,6 +4,7 @@
 #include <deal.II/lac/sparse_direct.h>
 #include <deal.II/lac/sparsity_pattern.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <limits>
@@ -161,12 +162,33 @@ namespace knee_contact
   {
     const unsigned int n_pairs = pairs.size();
     ContactSolution    result;
-    // Start from the pairs that touch (g_p = 0): this holds a body that only
-    // contact holds (a floating femur) from the first solve on.
+    // Start from the pairs that touch (g_p <= 0). A body that only contact
+    // holds (a floating femur, a mobile insert) may need more: close the
+    // smallest gaps first, doubling their number, until every body is held.
+    // The loop below releases any of them whose multiplier is negative.
     result.active.assign(n_pairs, false);
+    std::vector<unsigned int> by_gap;
     for (unsigned int p = 0; p < n_pairs; ++p)
-      result.active[p] =
-        pairs[p].eliminated != numbers::invalid_dof_index && pairs[p].gap <= 0;
+      if (pairs[p].eliminated != numbers::invalid_dof_index)
+        {
+          if (pairs[p].gap <= 0)
+            result.active[p] = true;
+          else
+            by_gap.push_back(p);
+        }
+    std::stable_sort(by_gap.begin(),
+                     by_gap.end(),
+                     [&pairs](const unsigned int a, const unsigned int b) {
+                       return pairs[a].gap < pairs[b].gap;
+                     });
+    for (std::size_t closed = 0;
+         closed < by_gap.size() &&
+         !rigid_modes.free_motion(base, pairs, result.active).empty();)
+      {
+        const std::size_t next = std::min(by_gap.size(), 2 * closed + 1);
+        for (; closed < next; ++closed)
+          result.active[by_gap[closed]] = true;
+      }
 
     std::set<std::vector<bool>> seen;
     SparseMatrix<double>        system_matrix(matrix.get_sparsity_pattern());

@@ -1,6 +1,9 @@
 #include <knee_contact/input.h>
 #include <knee_contact/output.h>
 
+#include <deal.II/base/quadrature_lib.h>
+
+#include <deal.II/fe/fe_values.h>
 #include <deal.II/numerics/data_out.h>
 #include <deal.II/numerics/data_postprocessor.h>
 
@@ -8,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -104,6 +108,17 @@ namespace knee_contact
                       "normal: progress, timings and a results table; test: "
                       "only numbers that do not depend on the machine, for "
                       "ctest.");
+    prm.declare_entry("Pictures",
+                      "true",
+                      Patterns::Bool(),
+                      "Draw deformation.png, stress_yy.png and "
+                      "contact_pressure.png with matplotlib (needs Write "
+                      "files).");
+    prm.declare_entry("Labels",
+                      "",
+                      Patterns::Anything(),
+                      "Points labelled in deformation.png: 'name: x, y; ...' "
+                      "[m], e.g. the seed's points 1-10.");
     prm.declare_entry("Write files",
                       "true",
                       Patterns::Bool(),
@@ -125,6 +140,21 @@ namespace knee_contact
     magnification = prm.get_double("Deformation magnification");
     terminal_test = prm.get("Terminal") == "test";
     write_files   = prm.get_bool("Write files");
+    pictures      = prm.get_bool("Pictures");
+    for (const auto &text : input::split(prm.get("Labels"), ';'))
+      if (!text.empty())
+        {
+          const auto name_point = input::split(text, ':');
+          const auto xy =
+            input::split(name_point.size() == 2 ? name_point[1] : "", ',');
+          AssertThrow(name_point.size() == 2 && xy.size() == 2,
+                      ExcMessage("Output/Labels: '" + text +
+                                 "' is not of the form 'name: x, y'"));
+          labels.emplace_back(name_point[0],
+                              Point<2>(input::to_double(xy[0], "Output/Labels"),
+                                       input::to_double(xy[1],
+                                                        "Output/Labels")));
+        }
     prm.leave_subsection();
   }
 
@@ -194,7 +224,70 @@ namespace knee_contact
     data_out.build_patches();
     write_atomically(output_folder + "/solution.vtu",
                      [&](std::ostream &out) { data_out.write_vtu(out); });
-    (void)magnification;
+  }
+
+
+
+  void
+  OutputWriter::write_cells(const DoFHandler<2>             &dof_handler,
+                            const std::vector<unsigned int> &body_of_cell,
+                            const Vector<double>            &solution,
+                            const Materials                 &materials) const
+  {
+    // tau_yy from the displacement gradient at each vertex of each cell.
+    FEValues<2>                        fe_values(dof_handler.get_fe(),
+                          QTrapezoid<2>(),
+                          update_values | update_gradients);
+    const FEValuesExtractors::Vector   u(0);
+    std::vector<Tensor<1, 2>>          values(4);
+    std::vector<SymmetricTensor<2, 2>> strains(4);
+    write_atomically(output_folder + "/cells.csv", [&](std::ostream &out) {
+      out << "material_id,body_id";
+      for (unsigned int v = 0; v < 4; ++v)
+        for (const char *name : {"x", "y", "u_x", "u_y", "stress_yy"})
+          out << ',' << name << v;
+      out << '\n' << std::setprecision(9);
+      for (const auto &cell : dof_handler.active_cell_iterators())
+        {
+          fe_values.reinit(cell);
+          fe_values[u].get_function_values(solution, values);
+          fe_values[u].get_function_symmetric_gradients(solution, strains);
+          const Material &material = materials[cell->material_id()];
+          out << static_cast<unsigned int>(cell->material_id()) << ','
+              << body_of_cell[cell->active_cell_index()];
+          // QTrapezoid's points are the vertices in deal.II's order; write
+          // them counter-clockwise.
+          for (const unsigned int v : {0u, 1u, 3u, 2u})
+            out << ',' << cell->vertex(v)[0] << ',' << cell->vertex(v)[1] << ','
+                << values[v][0] << ',' << values[v][1] << ','
+                << material.stress(strains[v])[1][1];
+          out << '\n';
+        }
+    });
+  }
+
+
+
+  bool
+  OutputWriter::make_pictures(std::string &message) const
+  {
+    if (!write_files || !pictures)
+      return true;
+    const std::string script =
+      std::string(KNEE_CONTACT_SOURCE_DIR) + "/scripts/plot_results.py";
+    const std::string log     = output_folder + "/pictures.log";
+    const std::string command = "/usr/bin/python3 '" + script + "' '" +
+                                output_folder + "' > '" + log + "' 2>&1";
+    if (std::system(command.c_str()) == 0)
+      {
+        std::filesystem::remove(log);
+        return true;
+      }
+    std::ifstream in(log);
+    std::string   line;
+    while (std::getline(in, line))
+      message = line;
+    return false;
   }
 
 
@@ -300,7 +393,10 @@ namespace knee_contact
       results.max_displacement > 0
         ? contact.max_penetration / results.max_displacement
         : 0.;
-    summary["complementarity_residual"] = contact.complementarity;
+    summary["complementarity_residual"]  = contact.complementarity;
+    summary["deformation_magnification"] = magnification;
+    for (const auto &[name, point] : labels)
+      summary["labels"][name] = {point[0], point[1]};
     if (!contact.converged)
       summary["failure"] = contact.failure;
     for (const auto &[phase, seconds] : wall_times)

@@ -352,6 +352,10 @@ namespace knee_contact
                                 contact_pairs,
                                 contact_solution,
                                 results);
+        output_writer.write_cells(dof_handler,
+                                  body_of_cell,
+                                  displacement,
+                                  materials);
         output_writer.write_contact_csv(contact_interfaces,
                                         contact_pairs,
                                         displacement,
@@ -364,6 +368,13 @@ namespace knee_contact
                                   contact_solution,
                                   materials,
                                   wall_times);
+    if (output_writer.enabled())
+      {
+        TimerOutput::Scope scope(timer, "pictures");
+        std::string        message;
+        if (!output_writer.make_pictures(message))
+          std::cout << "warning: no pictures: " << message << std::endl;
+      }
     if (!output_writer.test_mode())
       {
         std::cout << "wall time [s]:";

@@ -61,6 +61,17 @@ namespace knee_contact
                     const std::vector<bool>         &active,
                     const std::string               &context) const
   {
+    const std::string motion = free_motion(base, pairs, active);
+    AssertThrow(motion.empty(), ExcMessage(motion + "; " + context));
+  }
+
+
+
+  std::string
+  RigidModes::free_motion(const AffineConstraints<double> &base,
+                          const std::vector<ContactPair>  &pairs,
+                          const std::vector<bool>         &active) const
+  {
     const unsigned int n_modes = 3 * names.size();
     FullMatrix<double> gram(n_modes, n_modes);
     Vector<double>     w(n_modes);
@@ -112,7 +123,7 @@ namespace knee_contact
     matrix.compute_eigenvalues_symmetric(
       -1., threshold, 1e-14, eigenvalues, eigenvectors);
     if (eigenvalues.size() == 0)
-      return;
+      return "";
 
     // Name the body that moves most in the first free mode, and the motion.
     unsigned int body           = 0;
@@ -141,11 +152,9 @@ namespace knee_contact
              << centre[body][1] + tx / omega << ")";
     else
       motion << "translation along (" << tx / t << ", " << ty / t << ")";
-    AssertThrow(false,
-                ExcMessage("body " + std::to_string(body) + " (" + names[body] +
-                           ") is not held: its " + motion.str() +
-                           " is free of every displacement, sliding and "
-                           "active contact constraint; " +
-                           context));
+    return "body " + std::to_string(body) + " (" + names[body] +
+           ") is not held: its " + motion.str() +
+           " is free of every displacement, sliding and active contact "
+           "constraint";
   }
 } // namespace knee_contact

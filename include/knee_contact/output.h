@@ -55,6 +55,25 @@ namespace knee_contact
                       const ContactSolution          &contact,
                       const Results                  &results) const;
 
+    /**
+     * cells.csv: every cell's material and body id and, at its vertices
+     * (counter-clockwise), position, displacement and tau_yy; the data of the
+     * pictures.
+     */
+    void
+    write_cells(const DoFHandler<2>             &dof_handler,
+                const std::vector<unsigned int> &body_of_cell,
+                const Vector<double>            &solution,
+                const Materials                 &materials) const;
+
+    /**
+     * Run scripts/plot_results.py (matplotlib) on the folder: deformation,
+     * tau_yy and contact pressure pictures. Returns false, with the reason in
+     * @p message, if it could not.
+     */
+    bool
+    make_pictures(std::string &message) const;
+
     void
     write_summary(const Results                       &results,
                   const ContactSolution               &contact,
@@ -80,10 +99,12 @@ namespace knee_contact
     }
 
   private:
-    std::string output_folder;
-    double      magnification = 10;
-    bool        terminal_test = false;
-    bool        write_files   = true;
+    std::string                                   output_folder;
+    double                                        magnification = 10;
+    bool                                          pictures      = true;
+    std::vector<std::pair<std::string, Point<2>>> labels;
+    bool                                          terminal_test = false;
+    bool                                          write_files   = true;
   };
 } // namespace knee_contact
 

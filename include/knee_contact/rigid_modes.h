@@ -41,6 +41,15 @@ namespace knee_contact
           const std::vector<bool>         &active,
           const std::string               &context) const;
 
+    /**
+     * The same test; returns the description of the first free motion, or
+     * an empty string if every body is held.
+     */
+    std::string
+    free_motion(const AffineConstraints<double> &base,
+                const std::vector<ContactPair>  &pairs,
+                const std::vector<bool>         &active) const;
+
   private:
     std::vector<unsigned int> dof_body;
     std::vector<unsigned int> dof_component;
