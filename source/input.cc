@@ -17,7 +17,9 @@ namespace knee_contact
       const std::filesystem::path p(path);
       if (p.is_absolute() || path.empty())
         return path;
-      return (std::filesystem::path(scene_file).parent_path() / p)
+      // The scene's own folder, through symbolic links (build/knee.prm links
+      // to prm/knee.prm, whose mesh lies beside it).
+      return (std::filesystem::weakly_canonical(scene_file).parent_path() / p)
         .lexically_normal()
         .string();
     }

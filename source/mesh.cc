@@ -225,20 +225,20 @@ namespace knee_contact
                                     gmsh_arguments + " -o '" + msh + "' '" +
                                     file + "' > '" + log + "' 2>&1";
         const int   status = std::system(command.c_str());
-        std::string last_error;
+        std::string first_error;
         {
           std::ifstream in(log);
           for (std::string line; std::getline(in, line);)
-            if (line.find("rror") != std::string::npos)
-              last_error = line;
+            if (line.find("rror") != std::string::npos && first_error.empty())
+              first_error = line;
         }
-        if (status != 0 || !std::ifstream(msh).good() || !last_error.empty())
+        if (status != 0 || !std::ifstream(msh).good() || !first_error.empty())
           {
             std::filesystem::remove_all(temporary_folder);
             AssertThrow(false,
                         ExcMessage(
                           "Mesh/File: gmsh cannot mesh '" + file + "'" +
-                          (last_error.empty() ? "" : ": " + last_error)));
+                          (first_error.empty() ? "" : ": " + first_error)));
           }
       }
 

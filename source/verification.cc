@@ -5,6 +5,7 @@
 
 #include <deal.II/fe/fe_values.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 
@@ -73,6 +74,17 @@ namespace knee_contact
                       "0",
                       Patterns::Double(0),
                       "Allowed absolute error of the contact length [m].");
+    prm.declare_entry("Reference contact forces",
+                      "",
+                      Patterns::Anything(),
+                      "Expected magnitude of the contact force on each "
+                      "interface's slave body [N/m]: 'interface name: "
+                      "constant expression; ...', e.g. the load a body held "
+                      "only by that interface carries.");
+    prm.declare_entry("Contact force tolerance",
+                      "1e-8",
+                      Patterns::Double(0),
+                      "Allowed relative error of those forces.");
     prm.leave_subsection();
   }
 
@@ -107,6 +119,20 @@ namespace knee_contact
         input::evaluate_constant(prm.get("Reference contact length"),
                                  "Verification/Reference contact length");
     length_tolerance = prm.get_double("Contact length tolerance");
+    for (const auto &text : input::split(prm.get("Reference contact forces"),
+                                         ';'))
+      if (!text.empty())
+        {
+          const auto name_value = input::split(text, ':');
+          AssertThrow(name_value.size() == 2,
+                      ExcMessage("Verification/Reference contact forces: '" +
+                                 text + "' is not of the form 'name: value'"));
+          interface_forces.emplace_back(
+            name_value[0],
+            input::evaluate_constant(name_value[1],
+                                     "Verification/Reference contact forces"));
+        }
+    force_tolerance = prm.get_double("Contact force tolerance");
     prm.leave_subsection();
   }
 
@@ -335,6 +361,21 @@ namespace knee_contact
                std::abs(length - contact_length),
                "<=",
                length_tolerance);
+      }
+    for (const auto &[name, force] : interface_forces)
+      {
+        const auto it =
+          std::find_if(results.interfaces.begin(),
+                       results.interfaces.end(),
+                       [&](const InterfaceResult &i) { return i.name == name; });
+        AssertThrow(it != results.interfaces.end(),
+                    ExcMessage("Verification/Reference contact forces: no "
+                               "contact interface named '" +
+                               name + "'"));
+        report("relative error of the contact force on '" + name + "'",
+               std::abs(it->force_on_slave.norm() - force) / force,
+               "<=",
+               force_tolerance);
       }
     return n_failed;
   }

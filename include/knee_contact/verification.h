@@ -14,6 +14,8 @@
 #include <deal.II/dofs/dof_handler.h>
 
 #include <memory>
+#include <string>
+#include <utility>
 #include <ostream>
 #include <vector>
 
@@ -88,6 +90,8 @@ namespace knee_contact
     double                             peak_tolerance   = 0;
     double                             contact_length   = 0;
     double                             length_tolerance = 0;
+    std::vector<std::pair<std::string, double>> interface_forces;
+    double                                      force_tolerance = 1e-8;
   };
 } // namespace knee_contact
 
