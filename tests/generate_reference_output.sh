@@ -5,7 +5,7 @@
 set -u
 shopt -s nullglob
 cd "$(dirname "$0")/.."
-for source in tests/*.prm tests/*.cc; do
+for source in tests/*.prm tests/*.json tests/*.cc; do
   name=$(basename "${source%.*}")
   case $name in *_scene) continue ;; esac   # data for unit tests
   [ -f "tests/$name.output" ] || touch "tests/$name.output"
