@@ -41,6 +41,38 @@ namespace knee_contact
 
 
 
+    std::vector<std::pair<std::string, std::string>>
+    split_named(const std::string &text,
+                const std::string &parameter,
+                const std::string &form)
+    {
+      std::vector<std::pair<std::string, std::string>> entries;
+      for (const auto &entry : split(text, ';'))
+        if (!entry.empty())
+          {
+            const auto name_value = split(entry, ':');
+            AssertThrow(name_value.size() == 2 && !name_value[0].empty(),
+                        ExcMessage(parameter + ": '" + entry +
+                                   "' is not of the form '" + form + "'"));
+            entries.emplace_back(name_value[0], name_value[1]);
+          }
+      return entries;
+    }
+
+
+
+    Point<2>
+    to_point(const std::string &text, const std::string &parameter)
+    {
+      const auto xy = split(text, ',');
+      AssertThrow(xy.size() == 2,
+                  ExcMessage(parameter + ": '" + text +
+                             "' is not a point 'x, y'"));
+      return Point<2>(to_double(xy[0], parameter), to_double(xy[1], parameter));
+    }
+
+
+
     double
     to_double(const std::string &text, const std::string &parameter)
     {

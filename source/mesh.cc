@@ -117,24 +117,17 @@ namespace knee_contact
           rectangles.push_back(r);
         }
 
-    for (const auto &text : input::split(prm.get("Circular boundaries"), ';'))
-      if (!text.empty())
-        {
-          const auto id_centre = input::split(text, ':');
-          const auto centre =
-            input::split(id_centre.size() == 2 ? id_centre[1] : "", ',');
-          AssertThrow(id_centre.size() == 2 && centre.size() == 2,
-                      ExcMessage("Mesh/Circular boundaries: '" + text +
-                                 "' is not of the form 'id: x_c, y_c'"));
-          const double id =
-            input::to_double(id_centre[0], "Mesh/Circular boundaries");
-          AssertThrow(id >= 0 && id < 255 && id == std::floor(id),
-                      ExcMessage("Mesh/Circular boundaries: '" + id_centre[0] +
-                                 "' is not a boundary id"));
-          circular_boundaries[static_cast<types::boundary_id>(id)] =
-            Point<2>(input::to_double(centre[0], "Mesh/Circular boundaries"),
-                     input::to_double(centre[1], "Mesh/Circular boundaries"));
-        }
+    const std::string circles = "Mesh/Circular boundaries";
+    for (const auto &[id_text, centre] : input::split_named(
+           prm.get("Circular boundaries"), circles, "id: x_c, y_c"))
+      {
+        const double id = input::to_double(id_text, circles);
+        AssertThrow(id >= 0 && id < 255 && id == std::floor(id),
+                    ExcMessage(circles + ": '" + id_text +
+                               "' is not a boundary id"));
+        circular_boundaries[static_cast<types::boundary_id>(id)] =
+          input::to_point(centre, circles);
+      }
     prm.leave_subsection();
   }
 

@@ -141,20 +141,9 @@ namespace knee_contact
     terminal_test = prm.get("Terminal") == "test";
     write_files   = prm.get_bool("Write files");
     pictures      = prm.get_bool("Pictures");
-    for (const auto &text : input::split(prm.get("Labels"), ';'))
-      if (!text.empty())
-        {
-          const auto name_point = input::split(text, ':');
-          const auto xy =
-            input::split(name_point.size() == 2 ? name_point[1] : "", ',');
-          AssertThrow(name_point.size() == 2 && xy.size() == 2,
-                      ExcMessage("Output/Labels: '" + text +
-                                 "' is not of the form 'name: x, y'"));
-          labels.emplace_back(name_point[0],
-                              Point<2>(input::to_double(xy[0], "Output/Labels"),
-                                       input::to_double(xy[1],
-                                                        "Output/Labels")));
-        }
+    for (const auto &[name, point] :
+         input::split_named(prm.get("Labels"), "Output/Labels", "name: x, y"))
+      labels.emplace_back(name, input::to_point(point, "Output/Labels"));
     prm.leave_subsection();
   }
 

@@ -119,19 +119,14 @@ namespace knee_contact
         input::evaluate_constant(prm.get("Reference contact length"),
                                  "Verification/Reference contact length");
     length_tolerance = prm.get_double("Contact length tolerance");
-    for (const auto &text : input::split(prm.get("Reference contact forces"),
-                                         ';'))
-      if (!text.empty())
-        {
-          const auto name_value = input::split(text, ':');
-          AssertThrow(name_value.size() == 2,
-                      ExcMessage("Verification/Reference contact forces: '" +
-                                 text + "' is not of the form 'name: value'"));
-          interface_forces.emplace_back(
-            name_value[0],
-            input::evaluate_constant(name_value[1],
-                                     "Verification/Reference contact forces"));
-        }
+    for (const auto &[name, value] :
+         input::split_named(prm.get("Reference contact forces"),
+                            "Verification/Reference contact forces",
+                            "name: value"))
+      interface_forces.emplace_back(
+        name,
+        input::evaluate_constant(value,
+                                 "Verification/Reference contact forces"));
     force_tolerance = prm.get_double("Contact force tolerance");
     prm.leave_subsection();
   }
@@ -364,10 +359,11 @@ namespace knee_contact
       }
     for (const auto &[name, force] : interface_forces)
       {
-        const auto it =
-          std::find_if(results.interfaces.begin(),
-                       results.interfaces.end(),
-                       [&](const InterfaceResult &i) { return i.name == name; });
+        const auto it = std::find_if(results.interfaces.begin(),
+                                     results.interfaces.end(),
+                                     [&](const InterfaceResult &i) {
+                                       return i.name == name;
+                                     });
         AssertThrow(it != results.interfaces.end(),
                     ExcMessage("Verification/Reference contact forces: no "
                                "contact interface named '" +

@@ -3,9 +3,11 @@
 
 #include <deal.II/base/function_parser.h>
 #include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/point.h>
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace knee_contact
@@ -50,6 +52,22 @@ namespace knee_contact
      */
     std::vector<std::string>
     split(const std::string &text, const char separator);
+
+    /**
+     * Parse "name: value; name: value; ..." into (name, value) pairs; an
+     * entry without exactly one ':' is an error naming @p parameter and
+     * @p form, the expected shape of an entry.
+     */
+    std::vector<std::pair<std::string, std::string>>
+    split_named(const std::string &text,
+                const std::string &parameter,
+                const std::string &form);
+
+    /**
+     * A point from "x, y", or an error naming @p parameter.
+     */
+    Point<2>
+    to_point(const std::string &text, const std::string &parameter);
 
     /**
      * A finite double from @p text, or an error naming @p parameter.

@@ -14,9 +14,9 @@
 #include <deal.II/dofs/dof_handler.h>
 
 #include <memory>
+#include <ostream>
 #include <string>
 #include <utility>
-#include <ostream>
 #include <vector>
 
 namespace knee_contact
@@ -79,17 +79,17 @@ namespace knee_contact
     }
 
   private:
-    std::unique_ptr<FunctionParser<2>> exact_displacement;
-    std::unique_ptr<FunctionParser<2>> exact_stress;
-    std::unique_ptr<FunctionParser<2>> exact_pressure;
-    double                             tolerance        = 1e-10;
-    double                             min_l2_rate      = 0;
-    double                             min_energy_rate  = 0;
-    bool                               check_kkt        = true;
-    double                             peak_pressure    = 0;
-    double                             peak_tolerance   = 0;
-    double                             contact_length   = 0;
-    double                             length_tolerance = 0;
+    std::unique_ptr<FunctionParser<2>>          exact_displacement;
+    std::unique_ptr<FunctionParser<2>>          exact_stress;
+    std::unique_ptr<FunctionParser<2>>          exact_pressure;
+    double                                      tolerance        = 1e-10;
+    double                                      min_l2_rate      = 0;
+    double                                      min_energy_rate  = 0;
+    bool                                        check_kkt        = true;
+    double                                      peak_pressure    = 0;
+    double                                      peak_tolerance   = 0;
+    double                                      contact_length   = 0;
+    double                                      length_tolerance = 0;
     std::vector<std::pair<std::string, double>> interface_forces;
     double                                      force_tolerance = 1e-8;
   };
