@@ -1,6 +1,7 @@
 #include <knee_contact/boundary_conditions.h>
 #include <knee_contact/input.h>
 
+#include <deal.II/dofs/dof_tools.h>
 #include <deal.II/fe/mapping_q1.h>
 #include <deal.II/numerics/vector_tools.h>
 
@@ -126,7 +127,10 @@ namespace knee_contact
     const DoFHandler<2>       &dof_handler,
     AffineConstraints<double> &constraints) const
   {
+    // Hanging nodes of adaptive refinement first; in 2D they never lie on
+    // the boundary, so they do not meet the lines below.
     constraints.clear();
+    DoFTools::make_hanging_node_constraints(dof_handler, constraints);
     for (const auto &condition : list)
       if (condition.type == BoundaryType::displacement)
         for (const auto id : condition.ids)

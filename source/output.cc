@@ -257,13 +257,24 @@ namespace knee_contact
 
 
 
+  void
+  OutputWriter::write_file(
+    const std::string                         &name,
+    const std::function<void(std::ostream &)> &write) const
+  {
+    write_atomically(output_folder + "/" + name, write);
+  }
+
+
+
   bool
-  OutputWriter::make_pictures(std::string &message) const
+  OutputWriter::run_script(const std::string &script_name,
+                           std::string       &message) const
   {
     if (!write_files || !pictures)
       return true;
     const std::string script =
-      std::string(KNEE_CONTACT_SOURCE_DIR) + "/scripts/plot_results.py";
+      std::string(KNEE_CONTACT_SOURCE_DIR) + "/scripts/" + script_name;
     const std::string log     = output_folder + "/pictures.log";
     const std::string command = "/usr/bin/python3 '" + script + "' '" +
                                 output_folder + "' > '" + log + "' 2>&1";

@@ -3,6 +3,9 @@
 #include <knee_contact/problem.h>
 #include <knee_contact/rigid_modes.h>
 
+#include <deal.II/base/timer.h>
+#include <deal.II/base/utilities.h>
+
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 #include <deal.II/lac/sparse_direct.h>
 
@@ -11,6 +14,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 #include <iostream>
 #include <map>
@@ -87,13 +91,7 @@ namespace knee_contact
     ActiveSetSolver::declare_parameters(prm);
     OutputWriter::declare_parameters(prm);
     Verification::declare_parameters(prm);
-    prm.enter_subsection("Refinement");
-    prm.declare_entry("Number of cycles",
-                      "1",
-                      Patterns::Integer(1, 12),
-                      "Solve on this many meshes, refining every cell "
-                      "between them; errors and rates are tabulated.");
-    prm.leave_subsection();
+    Refinement::declare_parameters(prm);
   }
 
 
@@ -114,9 +112,7 @@ namespace knee_contact
     active_set_solver.parse_parameters(prm, materials.max_youngs_modulus());
     output_writer.parse_parameters(prm, scene_file);
     verification.parse_parameters(prm);
-    prm.enter_subsection("Refinement");
-    n_cycles = prm.get_integer("Number of cycles");
-    prm.leave_subsection();
+    refinement.parse_parameters(prm);
   }
 
 
@@ -231,43 +227,45 @@ namespace knee_contact
 
 
 
-  int
-  ContactProblem::run()
+  std::vector<CycleRecord>
+  ContactProblem::run_cycles(const Refinement::Strategy strategy,
+                             TimerOutput               &timer,
+                             Results                   &results)
   {
-    TimerOutput timer(log(), TimerOutput::never, TimerOutput::wall_times);
-    output_writer.prepare();
-    {
-      TimerOutput::Scope scope(timer, "mesh");
-      make_mesh();
-    }
-
-    std::vector<Errors> errors;
-    std::vector<double> n_dofs;
-    ConvergenceTable    table;
-    Results             results;
-    for (unsigned int cycle = 0; cycle < n_cycles; ++cycle)
+    std::vector<CycleRecord> records;
+    for (unsigned int cycle = 0; cycle < refinement.n_cycles; ++cycle)
       {
-        if (cycle > 0)
-          {
-            TimerOutput::Scope scope(timer, "mesh");
-            triangulation.refine_global(1);
-          }
-        {
-          TimerOutput::Scope scope(timer, "setup");
-          setup_system();
-        }
-        std::cout << "cycle " << cycle << ": " << triangulation.n_active_cells()
-                  << " cells, " << dof_handler.n_dofs() << " dofs, " << n_bodies
+        CycleRecord record;
+        record.strategy = Refinement::name(strategy);
+        record.cycle    = cycle;
+        // Each phase goes to the run's TimerOutput and to this cycle's row.
+        const auto timed = [&](const std::string           &phase,
+                               const std::function<void()> &work) {
+          TimerOutput::Scope scope(timer, phase);
+          Timer              clock;
+          work();
+          record.wall_time[phase] += clock.wall_time();
+        };
+
+        timed("mesh", [&]() {
+          if (cycle == 0)
+            make_mesh();
+          else
+            refinement.refine(
+              strategy, triangulation, dof_handler, displacement, materials);
+        });
+        timed("setup", [&]() { setup_system(); });
+        std::cout << record.strategy << " cycle " << cycle << ": "
+                  << triangulation.n_active_cells() << " cells, "
+                  << dof_handler.n_dofs() << " dofs, " << n_bodies
                   << " bodies, " << contact_pairs.size() << " contact pairs"
                   << std::endl;
-        {
-          TimerOutput::Scope  scope(timer, "assembly");
+        timed("assembly", [&]() {
           ElasticityAssembler assembler(materials, boundary_conditions);
           assembler.assemble(dof_handler, system_matrix, system_rhs);
-        }
-        {
-          TimerOutput::Scope scope(timer, "solve");
-          const RigidModes   rigid_modes(dof_handler, body_of_cell, body_names);
+        });
+        timed("solve", [&]() {
+          const RigidModes rigid_modes(dof_handler, body_of_cell, body_names);
           try
             {
               contact_solution =
@@ -287,10 +285,9 @@ namespace knee_contact
                                      "singular; check that every body is "
                                      "held"));
             }
-        }
-        {
-          TimerOutput::Scope scope(timer, "postprocess");
-          results = compute_results(dof_handler,
+        });
+        timed("postprocess", [&]() {
+          results       = compute_results(dof_handler,
                                     body_of_cell,
                                     system_matrix,
                                     system_rhs,
@@ -300,45 +297,50 @@ namespace knee_contact
                                     contact_interfaces,
                                     contact_pairs,
                                     contact_solution);
-          errors.push_back(verification.compute_errors(
-            dof_handler, displacement, materials, contact_pairs, results));
-        }
-        n_dofs.push_back(dof_handler.n_dofs());
-        table.add_value("cycle", cycle);
-        table.add_value("cells", triangulation.n_active_cells());
-        table.add_value("dofs", dof_handler.n_dofs());
-        if (!contact_pairs.empty())
-          {
-            table.add_value("pairs", contact_pairs.size());
-            table.add_value("iterations", contact_solution.n_iterations);
-            double peak = 0;
-            for (const auto &i : results.interfaces)
-              peak = std::max(peak, i.max_pressure);
-            table.add_value("peak pressure", peak);
-            table.set_scientific("peak pressure", true);
-          }
-        if (verification.has_exact_displacement())
-          {
-            table.add_value("L2 error", errors.back().l2_relative);
-            table.add_value("energy error", errors.back().energy_relative);
-            table.set_scientific("L2 error", true);
-            table.set_scientific("energy error", true);
-          }
-      }
+          record.errors = verification.compute_errors(
+            dof_handler, displacement, materials, contact_pairs, results);
+        });
 
-    if (verification.has_exact_displacement() && n_cycles > 1)
-      {
-        table.evaluate_convergence_rates("L2 error",
-                                         "dofs",
-                                         ConvergenceTable::reduction_rate_log2,
-                                         2);
-        table.evaluate_convergence_rates("energy error",
-                                         "dofs",
-                                         ConvergenceTable::reduction_rate_log2,
-                                         2);
+        record.n_cells      = triangulation.n_active_cells();
+        record.n_dofs       = dof_handler.n_dofs();
+        record.n_pairs      = contact_pairs.size();
+        record.n_iterations = contact_solution.n_iterations;
+        record.energy       = results.energy;
+        for (const auto &i : results.interfaces)
+          record.peak_pressure = std::max(record.peak_pressure, i.max_pressure);
+        for (const auto &phase : record.wall_time)
+          record.total_time += phase.second;
+        Utilities::System::MemoryStats memory;
+        Utilities::System::get_memory_stats(memory);
+        record.peak_memory = memory.VmHWM / 1024.;
+        records.push_back(record);
+        if (!contact_solution.converged)
+          break;
       }
-    if (n_cycles > 1)
-      table.write_text(std::cout);
+    return records;
+  }
+
+
+
+  int
+  ContactProblem::run()
+  {
+    TimerOutput timer(log(), TimerOutput::never, TimerOutput::wall_times);
+    output_writer.prepare();
+
+    // A study runs the uniform sequence first; the files and checks are
+    // those of the last sequence.
+    std::vector<Refinement::Strategy> strategies = {refinement.strategy};
+    if (refinement.strategy == Refinement::Strategy::compare)
+      strategies = {Refinement::Strategy::global,
+                    Refinement::Strategy::adaptive};
+    std::vector<std::vector<CycleRecord>> sequences;
+    Results                               results;
+    for (const auto strategy : strategies)
+      sequences.push_back(run_cycles(strategy, timer, results));
+    if (refinement.n_cycles > 1)
+      for (const auto &records : sequences)
+        print_convergence_table(records, !output_writer.test_mode(), std::cout);
 
     print_results(results);
 
@@ -361,18 +363,26 @@ namespace knee_contact
                                         displacement,
                                         contact_solution,
                                         results);
+        if (sequences.size() > 1)
+          output_writer.write_file("study.csv", [&](std::ostream &out) {
+            std::vector<CycleRecord> all;
+            for (const auto &records : sequences)
+              all.insert(all.end(), records.begin(), records.end());
+            write_study_csv(all, out);
+          });
       }
     auto wall_times = timer.get_summary_data(TimerOutput::total_wall_time);
     if (output_writer.enabled())
-      output_writer.write_summary(results,
-                                  contact_solution,
-                                  materials,
-                                  wall_times);
-    if (output_writer.enabled())
       {
+        output_writer.write_summary(results,
+                                    contact_solution,
+                                    materials,
+                                    wall_times);
         TimerOutput::Scope scope(timer, "pictures");
         std::string        message;
-        if (!output_writer.make_pictures(message))
+        if (!output_writer.run_script("plot_results.py", message) ||
+            (sequences.size() > 1 &&
+             !output_writer.run_script("plot_study.py", message)))
           std::cout << "warning: no pictures: " << message << std::endl;
       }
     if (!output_writer.test_mode())
@@ -386,12 +396,23 @@ namespace knee_contact
                     << std::endl;
       }
 
-    const unsigned int n_failed = verification.check(results,
-                                                     contact_solution,
-                                                     !contact_pairs.empty(),
-                                                     errors,
-                                                     n_dofs,
-                                                     std::cout);
+    std::vector<std::vector<Errors>> errors(sequences.size());
+    std::vector<std::vector<double>> n_dofs(sequences.size());
+    for (unsigned int s = 0; s < sequences.size(); ++s)
+      for (const auto &record : sequences[s])
+        {
+          errors[s].push_back(record.errors);
+          n_dofs[s].push_back(record.n_dofs);
+        }
+    unsigned int n_failed = verification.check(results,
+                                               contact_solution,
+                                               !contact_pairs.empty(),
+                                               errors.back(),
+                                               n_dofs.back(),
+                                               std::cout);
+    if (sequences.size() > 1)
+      n_failed += verification.check_study(
+        errors[0], n_dofs[0], errors[1], n_dofs[1], std::cout);
     if (!contact_solution.converged)
       {
         std::cerr << "knee_contact: not converged: " << contact_solution.failure

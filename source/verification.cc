@@ -74,6 +74,19 @@ namespace knee_contact
                       "0",
                       Patterns::Double(0),
                       "Allowed absolute error of the contact length [m].");
+    prm.declare_entry("Reference energy",
+                      "",
+                      Patterns::Anything(),
+                      "Constant expression for a(u,u) [J/m] of an overkill "
+                      "solution: its relative error is reported. Empty: "
+                      "none.");
+    prm.declare_entry("Reference extreme stress_yy",
+                      "",
+                      Patterns::Anything(),
+                      "'material name: value' [Pa]: the extreme (most "
+                      "negative if the value is negative, else largest) "
+                      "tau_yy in that material of an overkill solution; its "
+                      "relative error is reported. Empty: none.");
     prm.declare_entry("Reference contact forces",
                       "",
                       Patterns::Anything(),
@@ -128,6 +141,20 @@ namespace knee_contact
         input::evaluate_constant(value,
                                  "Verification/Reference contact forces"));
     force_tolerance = prm.get_double("Contact force tolerance");
+    if (!prm.get("Reference energy").empty())
+      reference_energy =
+        input::evaluate_constant(prm.get("Reference energy"),
+                                 "Verification/Reference energy");
+    for (const auto &[name, value] :
+         input::split_named(prm.get("Reference extreme stress_yy"),
+                            "Verification/Reference extreme stress_yy",
+                            "material name: value"))
+      {
+        extreme_stress_material = name;
+        extreme_stress =
+          input::evaluate_constant(value,
+                                   "Verification/Reference extreme stress_yy");
+      }
     prm.leave_subsection();
   }
 
@@ -251,8 +278,82 @@ namespace knee_contact
             largest = std::max(largest, std::abs(exact));
           }
         errors.pressure_relative = error / largest;
+        double l2 = 0, norm = 0;
+        for (unsigned int p = 0; p < pairs.size(); ++p)
+          {
+            const double exact = exact_pressure->value(pairs[p].position);
+            l2 += pairs[p].length * std::pow(results.pressure[p] - exact, 2);
+            norm += pairs[p].length * exact * exact;
+          }
+        errors.pressure_l2_relative = std::sqrt(l2 / norm);
       }
+    double max_pressure = 0, length = 0;
+    for (const auto &i : results.interfaces)
+      {
+        max_pressure = std::max(max_pressure, i.max_pressure);
+        length += i.contact_length;
+      }
+    if (peak_pressure != 0)
+      errors.peak_pressure_relative =
+        std::abs(max_pressure - peak_pressure) / peak_pressure;
+    if (contact_length != 0)
+      errors.contact_length_error = std::abs(length - contact_length);
+    if (reference_energy != 0)
+      errors.energy_reference_relative =
+        std::abs(results.energy - reference_energy) / reference_energy;
+    if (!extreme_stress_material.empty())
+      for (const auto &[id, range] : results.stress_yy_range)
+        if (materials[id].name == extreme_stress_material)
+          errors.stress_extreme_relative =
+            std::abs((extreme_stress < 0 ? range.first : range.second) -
+                     extreme_stress) /
+            std::abs(extreme_stress);
     return errors;
+  }
+
+
+
+  double
+  Errors::primary() const
+  {
+    return std::isnan(peak_pressure_relative) ? energy_relative
+                                              : peak_pressure_relative;
+  }
+
+
+
+  unsigned int
+  Verification::check_study(const std::vector<Errors> &uniform_errors,
+                            const std::vector<double> &uniform_dofs,
+                            const std::vector<Errors> &adaptive_errors,
+                            const std::vector<double> &adaptive_dofs,
+                            std::ostream              &out) const
+  {
+    unsigned int n_failed = 0;
+    const auto   pass     = [&](const bool ok) {
+      n_failed += ok ? 0 : 1;
+      return ok ? "PASS" : "FAIL";
+    };
+    const unsigned int n = uniform_errors.size();
+    if (n >= 3)
+      {
+        const bool decreasing =
+          uniform_errors[n - 3].primary() > uniform_errors[n - 2].primary() &&
+          uniform_errors[n - 2].primary() > uniform_errors[n - 1].primary();
+        out << "check uniform error decreases over its last 3 cycles: "
+            << pass(decreasing) << std::endl;
+      }
+    const double target = uniform_errors.back().primary();
+    double       dofs   = std::numeric_limits<double>::infinity();
+    for (unsigned int k = 0; k < adaptive_errors.size(); ++k)
+      if (adaptive_errors[k].primary() <= target)
+        dofs = std::min(dofs, adaptive_dofs[k]);
+    const double ratio = dofs / uniform_dofs.back();
+    out << "check adaptive dofs to reach the finest uniform error / uniform "
+           "dofs: "
+        << std::scientific << std::setprecision(3) << ratio << std::defaultfloat
+        << " < 1: " << pass(ratio < 1) << std::endl;
+    return n_failed;
   }
 
 
@@ -338,25 +439,15 @@ namespace knee_contact
           "equilibrium residual", results.equilibrium_residual, "<=", 1e-8);
       }
     if (peak_pressure != 0)
-      {
-        double max_pressure = 0;
-        for (const auto &i : results.interfaces)
-          max_pressure = std::max(max_pressure, i.max_pressure);
-        report("relative error of the peak pressure",
-               std::abs(max_pressure - peak_pressure) / peak_pressure,
-               "<=",
-               peak_tolerance);
-      }
+      report("relative error of the peak pressure",
+             last.peak_pressure_relative,
+             "<=",
+             peak_tolerance);
     if (contact_length != 0)
-      {
-        double length = 0;
-        for (const auto &i : results.interfaces)
-          length += i.contact_length;
-        report("error of the contact length [m]",
-               std::abs(length - contact_length),
-               "<=",
-               length_tolerance);
-      }
+      report("error of the contact length [m]",
+             last.contact_length_error,
+             "<=",
+             length_tolerance);
     for (const auto &[name, force] : interface_forces)
       {
         const auto it = std::find_if(results.interfaces.begin(),

@@ -12,6 +12,7 @@
 
 #include <deal.II/dofs/dof_handler.h>
 
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -67,12 +68,20 @@ namespace knee_contact
                 const Materials                 &materials) const;
 
     /**
-     * Run scripts/plot_results.py (matplotlib) on the folder: deformation,
-     * tau_yy and contact pressure pictures. Returns false, with the reason in
-     * @p message, if it could not.
+     * Run scripts/@p script (Debian's python3 with matplotlib) on the
+     * folder, e.g. plot_results.py: deformation, tau_yy and contact pressure
+     * pictures. Does nothing if pictures are off. Returns false, with the
+     * script's last line in @p message, if it failed.
      */
     bool
-    make_pictures(std::string &message) const;
+    run_script(const std::string &script, std::string &message) const;
+
+    /**
+     * Write the file @p name in the folder through a temporary file.
+     */
+    void
+    write_file(const std::string                         &name,
+               const std::function<void(std::ostream &)> &write) const;
 
     void
     write_summary(const Results                       &results,

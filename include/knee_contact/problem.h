@@ -7,7 +7,9 @@
 #include <knee_contact/materials.h>
 #include <knee_contact/mesh.h>
 #include <knee_contact/output.h>
+#include <knee_contact/refinement.h>
 #include <knee_contact/results.h>
+#include <knee_contact/study.h>
 #include <knee_contact/verification.h>
 
 #include <deal.II/base/convergence_table.h>
@@ -135,6 +137,16 @@ namespace knee_contact
     void
     setup_system();
 
+    /**
+     * Solve on Refinement::n_cycles meshes refined by @p strategy, starting
+     * from the coarse mesh; one record per cycle. Leaves the last solution
+     * in place and its derived quantities in @p results.
+     */
+    std::vector<CycleRecord>
+    run_cycles(const Refinement::Strategy strategy,
+               TimerOutput               &timer,
+               Results                   &results);
+
     std::ostream &
     log() const;
 
@@ -154,7 +166,7 @@ namespace knee_contact
     ActiveSetSolver    active_set_solver;
     OutputWriter       output_writer;
     Verification       verification;
-    unsigned int       n_cycles = 1;
+    Refinement         refinement;
 
     Triangulation<2>          triangulation;
     FESystem<2>               fe;

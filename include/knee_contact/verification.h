@@ -34,6 +34,21 @@ namespace knee_contact
     double nodal_relative    = std::numeric_limits<double>::quiet_NaN();
     double stress_relative   = std::numeric_limits<double>::quiet_NaN();
     double pressure_relative = std::numeric_limits<double>::quiet_NaN();
+    /** sqrt(sum l_p (p_h - p)^2 / sum l_p p^2) over the slave vertices. */
+    double pressure_l2_relative   = std::numeric_limits<double>::quiet_NaN();
+    double peak_pressure_relative = std::numeric_limits<double>::quiet_NaN();
+    double contact_length_error   = std::numeric_limits<double>::quiet_NaN();
+    /** |a(u,u) - reference| / reference. */
+    double energy_reference_relative = std::numeric_limits<double>::quiet_NaN();
+    /** Relative error of the extreme tau_yy in the reference material. */
+    double stress_extreme_relative = std::numeric_limits<double>::quiet_NaN();
+
+    /**
+     * The error a speed-against-error study ranks by: the peak pressure
+     * error if the scene gives a reference, else the energy error.
+     */
+    double
+    primary() const;
   };
 
 
@@ -59,6 +74,19 @@ namespace knee_contact
                    const Materials                &materials,
                    const std::vector<ContactPair> &pairs,
                    const Results                  &results) const;
+
+    /**
+     * The checks of a study (Refinement/Strategy = compare) on its two
+     * sequences: the primary error of the uniform sequence decreases over
+     * its last three cycles, and the adaptive sequence reaches the finest
+     * uniform error with fewer dofs. Returns the number that failed.
+     */
+    unsigned int
+    check_study(const std::vector<Errors> &uniform_errors,
+                const std::vector<double> &uniform_dofs,
+                const std::vector<Errors> &adaptive_errors,
+                const std::vector<double> &adaptive_dofs,
+                std::ostream              &out) const;
 
     /**
      * Print the checks of the final cycle and of the convergence rates;
@@ -90,6 +118,9 @@ namespace knee_contact
     double                                      peak_tolerance   = 0;
     double                                      contact_length   = 0;
     double                                      length_tolerance = 0;
+    double                                      reference_energy = 0;
+    std::string                                 extreme_stress_material;
+    double                                      extreme_stress = 0;
     std::vector<std::pair<std::string, double>> interface_forces;
     double                                      force_tolerance = 1e-8;
   };
