@@ -18,6 +18,7 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <set>
 
 namespace knee_contact
 {
@@ -173,31 +174,46 @@ namespace knee_contact
     boundary_conditions.make_constraints(dof_handler, constraints);
     contact_pairs = contact_interfaces.make_pairs(dof_handler, constraints);
 
-    // One sparsity pattern serves every active set. Condensing a subset of
-    // the contact lines couples each dof i with the dofs its line refers to,
-    // E(i), so an entry (i, j) of the mesh's pattern needs E(i) x E(j) for
-    // whichever of i, j are constrained; E(i) holds both the reduced row of
-    // a pair (partner lines inactive) and its fully resolved form (partners
-    // active), as well as the Gamma_u/Gamma_o entries.
-    AffineConstraints<double> all_pairs;
-    ActiveSetSolver::make_constraints(constraints,
-                                      contact_pairs,
-                                      std::vector<bool>(contact_pairs.size(),
-                                                        true),
-                                      all_pairs);
-    std::map<types::global_dof_index, std::vector<types::global_dof_index>>
-      expansion;
-    for (const auto &line : all_pairs.get_lines())
-      {
-        auto &e = expansion[line.index];
-        e.push_back(line.index);
-        for (const auto &entry : line.entries)
-          e.push_back(entry.first);
-      }
+    // One sparsity pattern serves every active set. Condensing a set of
+    // lines couples each dof i with the dofs its line refers to after
+    // chains are resolved, and which chains exist depends on the active set
+    // (a hanging node refers to a slave dof, which refers to master dofs
+    // only while its pair is active). So E(i) is the transitive closure of
+    // the one-level entries R(i) (Gamma_u/Gamma_o/hanging-node line, or the
+    // reduced row of the pair eliminating i), and an entry (i, j) of the
+    // mesh's pattern needs E(i) x E(j).
+    std::map<types::global_dof_index, std::set<types::global_dof_index>>
+      one_level;
+    for (const auto &line : constraints.get_lines())
+      for (const auto &entry : line.entries)
+        one_level[line.index].insert(entry.first);
     for (const auto &pair : contact_pairs)
       if (pair.eliminated != numbers::invalid_dof_index)
         for (const auto &entry : pair.reduced_row)
-          expansion[pair.eliminated].push_back(entry.first);
+          if (entry.first != pair.eliminated)
+            one_level[pair.eliminated].insert(entry.first);
+    std::map<types::global_dof_index, std::vector<types::global_dof_index>>
+      expansion;
+    const std::function<const std::vector<types::global_dof_index> &(
+      types::global_dof_index)>
+      closure = [&](const types::global_dof_index i)
+      -> const std::vector<types::global_dof_index> & {
+      const auto known = expansion.find(i);
+      if (known != expansion.end())
+        return known->second;
+      std::set<types::global_dof_index> dofs = {i};
+      const auto                        it   = one_level.find(i);
+      if (it != one_level.end())
+        for (const auto e : it->second)
+          {
+            const auto &sub = closure(e);
+            dofs.insert(sub.begin(), sub.end());
+          }
+      return expansion[i] =
+               std::vector<types::global_dof_index>(dofs.begin(), dofs.end());
+    };
+    for (const auto &entry : one_level)
+      closure(entry.first);
 
     DynamicSparsityPattern mesh_pattern(dof_handler.n_dofs());
     DoFTools::make_sparsity_pattern(dof_handler, mesh_pattern);

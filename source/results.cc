@@ -2,6 +2,9 @@
 
 #include <deal.II/base/quadrature_lib.h>
 
+#include <deal.II/lac/affine_constraints.h>
+
+#include <deal.II/dofs/dof_tools.h>
 #include <deal.II/fe/fe_values.h>
 
 #include <algorithm>
@@ -39,6 +42,19 @@ namespace knee_contact
     for (unsigned int p = 0; p < pairs.size(); ++p)
       for (const auto &[dof, a] : pairs[p].row)
         support_force(dof) += a * contact.lambda[p];
+    // A hanging node's force belongs to the vertices it hangs from:
+    // apply the transpose of its constraint.
+    {
+      AffineConstraints<double> hanging;
+      DoFTools::make_hanging_node_constraints(dof_handler, hanging);
+      hanging.close();
+      for (const auto &line : hanging.get_lines())
+        {
+          for (const auto &[j, c] : line.entries)
+            support_force(j) += c * support_force(line.index);
+          support_force(line.index) = 0;
+        }
+    }
     results.energy           = matrix.matrix_norm_square(solution);
     results.max_displacement = solution.linfty_norm();
 
