@@ -157,21 +157,22 @@ namespace knee_contact
                          const AffineConstraints<double> &base,
                          const std::vector<ContactPair>  &pairs,
                          const RigidModes                &rigid_modes,
+                         const std::vector<bool>         &guess,
                          Vector<double>                  &solution,
                          std::ostream                    &log) const
   {
     const unsigned int n_pairs = pairs.size();
     ContactSolution    result;
-    // Start from the pairs that touch (g_p <= 0). A body that only contact
-    // holds (a floating femur, a mobile insert) may need more: close the
-    // smallest gaps first, doubling their number, until every body is held.
-    // The loop below releases any of them whose multiplier is negative.
+    // Start from the pairs that touch (g_p <= 0) and the guess. A body that
+    // only contact holds (a floating femur, a mobile insert) may need more:
+    // close the smallest gaps first, doubling their number, until every body is
+    // held. The loop below releases any of them whose multiplier is negative.
     result.active.assign(n_pairs, false);
     std::vector<unsigned int> by_gap;
     for (unsigned int p = 0; p < n_pairs; ++p)
       if (pairs[p].eliminated != numbers::invalid_dof_index)
         {
-          if (pairs[p].gap <= 0)
+          if (pairs[p].gap <= 0 || (!guess.empty() && guess[p]))
             result.active[p] = true;
           else
             by_gap.push_back(p);

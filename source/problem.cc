@@ -267,8 +267,14 @@ namespace knee_contact
           if (cycle == 0)
             make_mesh();
           else
-            refinement.refine(
-              strategy, triangulation, dof_handler, displacement, materials);
+            refinement.refine(strategy,
+                              triangulation,
+                              dof_handler,
+                              displacement,
+                              materials,
+                              contact_interfaces,
+                              contact_pairs,
+                              contact_solution);
         });
         timed("setup", [&]() { setup_system(); });
         std::cout << record.strategy << " cycle " << cycle << ": "
@@ -282,6 +288,14 @@ namespace knee_contact
         });
         timed("solve", [&]() {
           const RigidModes rigid_modes(dof_handler, body_of_cell, body_names);
+          // Warm start on a refined mesh: pairs within the previous contact
+          // zone start active (the loop corrects the guess).
+          std::vector<bool> guess(contact_pairs.size(), false);
+          if (cycle > 0)
+            for (unsigned int p = 0; p < contact_pairs.size(); ++p)
+              for (const auto &[position, length] : previous_contact)
+                if (contact_pairs[p].position.distance(position) <= length)
+                  guess[p] = true;
           try
             {
               contact_solution =
@@ -290,6 +304,7 @@ namespace knee_contact
                                         constraints,
                                         contact_pairs,
                                         rigid_modes,
+                                        guess,
                                         displacement,
                                         contact_pairs.empty() ? quiet
                                                               : std::cout);
@@ -317,6 +332,11 @@ namespace knee_contact
             dof_handler, displacement, materials, contact_pairs, results);
         });
 
+        previous_contact.clear();
+        for (unsigned int p = 0; p < contact_pairs.size(); ++p)
+          if (contact_solution.active[p])
+            previous_contact.emplace_back(contact_pairs[p].position,
+                                          contact_pairs[p].length);
         record.n_cells      = triangulation.n_active_cells();
         record.n_dofs       = dof_handler.n_dofs();
         record.n_pairs      = contact_pairs.size();
@@ -326,6 +346,11 @@ namespace knee_contact
           record.peak_pressure = std::max(record.peak_pressure, i.max_pressure);
         for (const auto &phase : record.wall_time)
           record.total_time += phase.second;
+        if (!output_writer.test_mode())
+          std::cout << std::setprecision(7) << "   " << record.n_dofs
+                    << " dofs: peak pressure " << record.peak_pressure
+                    << ", energy " << record.energy << ", " << record.total_time
+                    << " s" << std::endl;
         Utilities::System::MemoryStats memory;
         Utilities::System::get_memory_stats(memory);
         record.peak_memory = memory.VmHWM / 1024.;

@@ -5,6 +5,7 @@
 #include <deal.II/grid/grid_refinement.h>
 #include <deal.II/numerics/error_estimator.h>
 
+#include <array>
 #include <cmath>
 
 namespace knee_contact
@@ -31,6 +32,14 @@ namespace knee_contact
                       Patterns::Double(0, 1),
                       "Adaptive: refine the cells that together carry this "
                       "fraction of the estimated error (fixed fraction).");
+    prm.declare_entry("Indicator",
+                      "kelly+contact",
+                      Patterns::Selection("kelly|kelly+contact"),
+                      "Adaptive: kelly, or kelly+contact, which also refines "
+                      "every cell at the active contact zone (one slave "
+                      "vertex spacing around it), where the pressure is "
+                      "resolved. Both sides of an interface are refined "
+                      "together.");
     prm.leave_subsection();
   }
 
@@ -52,11 +61,14 @@ namespace knee_contact
 
 
   void
-  Refinement::refine(const Strategy        strategy,
-                     Triangulation<2>     &triangulation,
-                     const DoFHandler<2>  &dof_handler,
-                     const Vector<double> &solution,
-                     const Materials      &materials) const
+  Refinement::refine(const Strategy                  strategy,
+                     Triangulation<2>               &triangulation,
+                     const DoFHandler<2>            &dof_handler,
+                     const Vector<double>           &solution,
+                     const Materials                &materials,
+                     const ContactInterfaces        &interfaces,
+                     const std::vector<ContactPair> &pairs,
+                     const ContactSolution          &contact) const
   {
     if (strategy == Strategy::global)
       {
@@ -73,7 +85,66 @@ namespace knee_contact
                                                       indicator,
                                                       refine_fraction,
                                                       0.);
+    if (contact_indicator)
+      {
+        // The contact zone: within one slave spacing of an active pair, on
+        // either side.
+        std::vector<std::pair<Point<2>, double>> zone;
+        for (unsigned int p = 0; p < pairs.size(); ++p)
+          if (contact.active[p])
+            zone.emplace_back(pairs[p].position, 2 * pairs[p].length);
+        for (const auto &cell : triangulation.active_cell_iterators())
+          for (const unsigned int v : cell->vertex_indices())
+            for (const auto &[centre, radius] : zone)
+              if (cell->vertex(v).distance(centre) <= radius)
+                cell->set_refine_flag();
+      }
+    mark_partners(triangulation, interfaces);
     triangulation.execute_coarsening_and_refinement();
+  }
+
+
+
+  void
+  Refinement::mark_partners(Triangulation<2>        &triangulation,
+                            const ContactInterfaces &interfaces) const
+  {
+    struct Side
+    {
+      Triangulation<2>::active_cell_iterator cell;
+      Point<2>                               centre;
+      double                                 length;
+    };
+    for (const auto &interface : interfaces.interfaces())
+      {
+        std::array<std::vector<Side>, 2> sides;
+        for (const auto &cell : triangulation.active_cell_iterators())
+          for (const auto &face : cell->face_iterators())
+            if (face->at_boundary())
+              for (unsigned int k = 0; k < 2; ++k)
+                if (face->boundary_id() ==
+                    (k == 0 ? interface.slave_id : interface.master_id))
+                  sides[k].push_back({cell, face->center(), face->measure()});
+        // A marked face of length h becomes h/2; an opposite face that
+        // overlaps it (centres closer than half their lengths plus a face)
+        // and is longer than h is marked too.
+        for (bool changed = true; changed;)
+          {
+            changed = false;
+            for (unsigned int k = 0; k < 2; ++k)
+              for (const Side &marked : sides[k])
+                if (marked.cell->refine_flag_set())
+                  for (const Side &other : sides[1 - k])
+                    if (!other.cell->refine_flag_set() &&
+                        other.length > 0.75 * marked.length &&
+                        other.centre.distance(marked.centre) <
+                          0.5 * (other.length + marked.length))
+                      {
+                        other.cell->set_refine_flag();
+                        changed = true;
+                      }
+          }
+      }
   }
 
 

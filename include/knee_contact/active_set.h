@@ -55,8 +55,10 @@ namespace knee_contact
 
     /**
      * Solve; @p matrix and @p rhs are the unconstrained C and d, and
-     * @p pattern must hold the entries of every condensed system. @p log
-     * receives one line per iteration.
+     * @p matrix's pattern must hold the entries of every condensed system.
+     * @p guess marks pairs to start active besides the touching ones (e.g.
+     * the contact zone of a coarser mesh); empty: none. @p log receives one
+     * line per iteration.
      */
     ContactSolution
     solve(const SparseMatrix<double>      &matrix,
@@ -64,6 +66,7 @@ namespace knee_contact
           const AffineConstraints<double> &base,
           const std::vector<ContactPair>  &pairs,
           const RigidModes                &rigid_modes,
+          const std::vector<bool>         &guess,
           Vector<double>                  &solution,
           std::ostream                    &log) const;
 

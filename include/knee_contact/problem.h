@@ -182,6 +182,8 @@ namespace knee_contact
     Vector<double>            system_rhs;
     Vector<double>            displacement;
     ContactSolution           contact_solution;
+    /** Positions and slave lengths of the last cycle's active pairs. */
+    std::vector<std::pair<Point<2>, double>> previous_contact;
 
     mutable std::ostringstream quiet;
   };

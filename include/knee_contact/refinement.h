@@ -1,6 +1,8 @@
 #ifndef knee_contact_refinement_h
 #define knee_contact_refinement_h
 
+#include <knee_contact/active_set.h>
+#include <knee_contact/contact.h>
 #include <knee_contact/materials.h>
 
 #include <deal.II/base/parameter_handler.h>
@@ -46,11 +48,14 @@ namespace knee_contact
      * across materials; refinement by fixed fraction of the estimate.
      */
     void
-    refine(const Strategy        strategy,
-           Triangulation<2>     &triangulation,
-           const DoFHandler<2>  &dof_handler,
-           const Vector<double> &solution,
-           const Materials      &materials) const;
+    refine(const Strategy                  strategy,
+           Triangulation<2>               &triangulation,
+           const DoFHandler<2>            &dof_handler,
+           const Vector<double>           &solution,
+           const Materials                &materials,
+           const ContactInterfaces        &interfaces,
+           const std::vector<ContactPair> &pairs,
+           const ContactSolution          &contact) const;
 
     static std::string
     name(const Strategy strategy);
@@ -59,7 +64,18 @@ namespace knee_contact
     Strategy     strategy = Strategy::global;
 
   private:
-    double refine_fraction = 0.5;
+    /**
+     * Mark the cells across each contact interface whose faces lie opposite
+     * a marked boundary cell and are longer than its children will be, in
+     * both directions until nothing changes, so the two sides stay about
+     * equally fine (node-to-segment pairing handles any mismatch left).
+     */
+    void
+    mark_partners(Triangulation<2>        &triangulation,
+                  const ContactInterfaces &interfaces) const;
+
+    double refine_fraction   = 0.5;
+    bool   contact_indicator = true;
   };
 } // namespace knee_contact
 
