@@ -249,7 +249,10 @@ namespace knee_contact
                              Results                   &results)
   {
     std::vector<CycleRecord> records;
-    for (unsigned int cycle = 0; cycle < refinement.n_cycles; ++cycle)
+    const unsigned int       n_cycles = strategy == Refinement::Strategy::global
+                                          ? refinement.n_cycles
+                                          : refinement.n_adaptive_cycles;
+    for (unsigned int cycle = 0; cycle < n_cycles; ++cycle)
       {
         CycleRecord record;
         record.strategy = Refinement::name(strategy);
@@ -379,8 +382,8 @@ namespace knee_contact
     Results                               results;
     for (const auto strategy : strategies)
       sequences.push_back(run_cycles(strategy, timer, results));
-    if (refinement.n_cycles > 1)
-      for (const auto &records : sequences)
+    for (const auto &records : sequences)
+      if (records.size() > 1)
         print_convergence_table(records, !output_writer.test_mode(), std::cout);
 
     print_results(results);

@@ -19,6 +19,11 @@ namespace knee_contact
                       Patterns::Integer(1, 20),
                       "Solve on this many meshes, refining between them; "
                       "errors and rates are tabulated.");
+    prm.declare_entry("Number of adaptive cycles",
+                      "0",
+                      Patterns::Integer(0, 30),
+                      "Cycles of the adaptive sequence, which grows more "
+                      "slowly than the uniform one; 0: Number of cycles.");
     prm.declare_entry("Strategy",
                       "global",
                       Patterns::Selection("global|adaptive|compare"),
@@ -49,7 +54,10 @@ namespace knee_contact
   Refinement::parse_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Refinement");
-    n_cycles            = prm.get_integer("Number of cycles");
+    n_cycles          = prm.get_integer("Number of cycles");
+    n_adaptive_cycles = prm.get_integer("Number of adaptive cycles");
+    if (n_adaptive_cycles == 0)
+      n_adaptive_cycles = n_cycles;
     const std::string s = prm.get("Strategy");
     strategy            = s == "global"     ? Strategy::global
                           : s == "adaptive" ? Strategy::adaptive

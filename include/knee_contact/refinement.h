@@ -61,7 +61,9 @@ namespace knee_contact
     name(const Strategy strategy);
 
     unsigned int n_cycles = 1;
-    Strategy     strategy = Strategy::global;
+    /** Cycles of the adaptive sequence (Strategy = adaptive or compare). */
+    unsigned int n_adaptive_cycles = 1;
+    Strategy     strategy          = Strategy::global;
 
   private:
     /**
