@@ -174,70 +174,10 @@ namespace knee_contact
     boundary_conditions.make_constraints(dof_handler, constraints);
     contact_pairs = contact_interfaces.make_pairs(dof_handler, constraints);
 
-    // One sparsity pattern serves every active set. Condensing a set of
-    // lines couples each dof i with the dofs its line refers to after
-    // chains are resolved, and which chains exist depends on the active set
-    // (a hanging node refers to a slave dof, which refers to master dofs
-    // only while its pair is active). So E(i) is the transitive closure of
-    // the one-level entries R(i) (Gamma_u/Gamma_o/hanging-node line, or the
-    // reduced row of the pair eliminating i), and an entry (i, j) of the
-    // mesh's pattern needs E(i) x E(j).
-    std::map<types::global_dof_index, std::set<types::global_dof_index>>
-      one_level;
-    for (const auto &line : constraints.get_lines())
-      for (const auto &entry : line.entries)
-        one_level[line.index].insert(entry.first);
-    for (const auto &pair : contact_pairs)
-      if (pair.eliminated != numbers::invalid_dof_index)
-        for (const auto &entry : pair.reduced_row)
-          if (entry.first != pair.eliminated)
-            one_level[pair.eliminated].insert(entry.first);
-    std::map<types::global_dof_index, std::vector<types::global_dof_index>>
-      expansion;
-    const std::function<const std::vector<types::global_dof_index> &(
-      types::global_dof_index)>
-      closure = [&](const types::global_dof_index i)
-      -> const std::vector<types::global_dof_index> & {
-      const auto known = expansion.find(i);
-      if (known != expansion.end())
-        return known->second;
-      std::set<types::global_dof_index> dofs = {i};
-      const auto                        it   = one_level.find(i);
-      if (it != one_level.end())
-        for (const auto e : it->second)
-          {
-            const auto &sub = closure(e);
-            dofs.insert(sub.begin(), sub.end());
-          }
-      return expansion[i] =
-               std::vector<types::global_dof_index>(dofs.begin(), dofs.end());
-    };
-    for (const auto &entry : one_level)
-      closure(entry.first);
-
-    DynamicSparsityPattern mesh_pattern(dof_handler.n_dofs());
-    DoFTools::make_sparsity_pattern(dof_handler, mesh_pattern);
-    DynamicSparsityPattern dsp(dof_handler.n_dofs());
-    for (types::global_dof_index i = 0; i < dof_handler.n_dofs(); ++i)
-      {
-        const auto ei = expansion.find(i);
-        for (auto it = mesh_pattern.begin(i); it != mesh_pattern.end(i); ++it)
-          {
-            const types::global_dof_index j  = it->column();
-            const auto                    ej = expansion.find(j);
-            if (ei == expansion.end() && ej == expansion.end())
-              dsp.add(i, j);
-            else
-              for (const auto a : ei == expansion.end()
-                                    ? std::vector<types::global_dof_index>{i}
-                                    : ei->second)
-                for (const auto b : ej == expansion.end()
-                                      ? std::vector<types::global_dof_index>{j}
-                                      : ej->second)
-                  dsp.add(a, b);
-          }
-      }
-    sparsity_pattern.copy_from(dsp);
+    ActiveSetSolver::make_sparsity_pattern(dof_handler,
+                                           constraints,
+                                           contact_pairs,
+                                           sparsity_pattern);
     system_matrix.reinit(sparsity_pattern);
   }
 

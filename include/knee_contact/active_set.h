@@ -8,7 +8,10 @@
 
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/sparse_matrix.h>
+#include <deal.II/lac/sparsity_pattern.h>
 #include <deal.II/lac/vector.h>
+
+#include <deal.II/dofs/dof_handler.h>
 
 #include <ostream>
 #include <string>
@@ -69,6 +72,16 @@ namespace knee_contact
           const std::vector<bool>         &guess,
           Vector<double>                  &solution,
           std::ostream                    &log) const;
+
+    /**
+     * One sparsity pattern for the condensed systems of every active set of
+     * @p pairs under @p base (see the comment in the code).
+     */
+    static void
+    make_sparsity_pattern(const DoFHandler<2>             &dof_handler,
+                          const AffineConstraints<double> &base,
+                          const std::vector<ContactPair>  &pairs,
+                          SparsityPattern                 &sparsity_pattern);
 
     /**
      * The constraints of @p base plus the active rows of @p pairs, closed.
