@@ -400,7 +400,9 @@ namespace knee_contact
     if (!contact_solution.converged)
       {
         std::cerr << "knee_contact: not converged: " << contact_solution.failure
-                  << " (last iterate written with converged = false)"
+                  << (output_writer.enabled() ?
+                        " (last iterate written with converged = false)" :
+                        "")
                   << std::endl;
         return ExitCode::not_converged;
       }
