@@ -400,9 +400,9 @@ namespace knee_contact
     if (!contact_solution.converged)
       {
         std::cerr << "knee_contact: not converged: " << contact_solution.failure
-                  << (output_writer.enabled() ?
-                        " (last iterate written with converged = false)" :
-                        "")
+                  << (output_writer.enabled()
+                        ? " (last iterate written with converged = false)"
+                        : "")
                   << std::endl;
         return ExitCode::not_converged;
       }
