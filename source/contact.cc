@@ -336,9 +336,8 @@ namespace knee_contact
                     if (on_slave == slave_side && !eliminated.count(dof) &&
                         std::abs(a) > largest + 1e-12)
                       {
-                        largest               = std::abs(a);
-                        pair.eliminated       = dof;
-                        pair.slave_eliminated = slave_side;
+                        largest         = std::abs(a);
+                        pair.eliminated = dof;
                       }
                   }
                 if (pair.eliminated != numbers::invalid_dof_index)

@@ -160,15 +160,4 @@ namespace knee_contact
       E = std::max(E, m.second.youngs_modulus);
     return E;
   }
-
-
-
-  std::vector<types::material_id>
-  Materials::ids() const
-  {
-    std::vector<types::material_id> result;
-    for (const auto &m : materials)
-      result.push_back(m.first);
-    return result;
-  }
 } // namespace knee_contact

@@ -80,9 +80,6 @@ namespace knee_contact
     double
     max_youngs_modulus() const;
 
-    std::vector<types::material_id>
-    ids() const;
-
   private:
     std::map<types::material_id, Material> materials;
   };

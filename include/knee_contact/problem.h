@@ -12,7 +12,6 @@
 #include <knee_contact/study.h>
 #include <knee_contact/verification.h>
 
-#include <deal.II/base/convergence_table.h>
 #include <deal.II/base/parameter_handler.h>
 #include <deal.II/base/timer.h>
 

@@ -100,11 +100,6 @@ namespace knee_contact
           const std::vector<double> &n_dofs,
           std::ostream              &out) const;
 
-    bool
-    has_exact_displacement() const
-    {
-      return exact_displacement != nullptr;
-    }
 
   private:
     std::unique_ptr<FunctionParser<2>>          exact_displacement;
