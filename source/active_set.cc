@@ -307,6 +307,7 @@ namespace knee_contact
         const double u_scale = std::max(solution.linfty_norm(), 1e-300);
         if (lambda_scale == 0)
           lambda_scale = 1;
+        const double      force_scale = rhs.linfty_norm() + lambda_scale;
         std::vector<bool> next(n_pairs, false);
         unsigned int      n_entered = 0, n_left = 0, n_active = 0;
         result.complementarity = 0;
@@ -319,8 +320,13 @@ namespace knee_contact
               std::max(result.complementarity,
                        std::abs(std::min(result.lambda[p] / lambda_scale,
                                          -excess / u_scale)));
-            next[p] = pairs[p].eliminated != numbers::invalid_dof_index &&
-                      result.lambda[p] + c * excess > 0;
+            // An active pair stays while lambda_p >= 0 up to round-off: an
+            // unloaded contact (lambda = 0, zero load) is a solution, and
+            // the strict test would release a body that only contact holds.
+            next[p] =
+              pairs[p].eliminated != numbers::invalid_dof_index &&
+              (result.lambda[p] + c * excess > 0 ||
+               (result.active[p] && result.lambda[p] >= -1e-12 * force_scale));
             n_active += next[p];
             n_entered += next[p] && !result.active[p];
             n_left += !next[p] && result.active[p];

@@ -263,7 +263,8 @@ namespace knee_contact
                       largest = std::max(largest, std::abs(exact(d)));
                     }
                 }
-            errors.nodal_relative = nodal / largest;
+            // Absolute where the reference is zero everywhere.
+            errors.nodal_relative = nodal / (largest > 0 ? largest : 1.);
           }
         if (exact_stress)
           errors.stress_relative = stress_error / stress_max;

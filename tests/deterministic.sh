@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Runs SCENE three times, twice with 2 threads and once with 1
+# (DEAL_II_NUM_THREADS), writing files, and passes only if every number of
+# summary.json except the wall times is identical bit for bit (as printed,
+# 17 significant digits) across the three runs.
+# Usage: deterministic.sh PROGRAM SCENE
+set -u
+export LC_ALL=C
+program=$1
+scene=$2
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+for run in a b c; do
+  sed -e 's/^  set Write files = false/  set Write files = true\n  set Pictures    = false\n  set Folder      = '"$run"'/' \
+      -e "s|= \.\./prm/|= $(dirname "$scene")/../prm/|" "$scene" >"$work/$run.prm"
+  threads=2
+  [ $run = c ] && threads=1
+  (cd "$work" && DEAL_II_NUM_THREADS=$threads "$program" "$run.prm" >/dev/null) ||
+    { echo "FAIL: run $run exited non-zero"; exit 1; }
+  /usr/bin/python3 -c '
+import json, sys
+d = json.load(open(sys.argv[1]))
+d.pop("wall_time", None)
+print(json.dumps(d, sort_keys=True))' "$work/$run/summary.json" >"$work/$run.json"
+done
+if cmp -s "$work/a.json" "$work/b.json" && cmp -s "$work/a.json" "$work/c.json"; then
+  echo "PASS: summary.json identical across 2 runs with 2 threads and 1 run with 1 thread"
+else
+  diff "$work/a.json" "$work/c.json" | head -5
+  echo "FAIL: results differ between runs"
+  exit 1
+fi
