@@ -130,10 +130,10 @@ namespace knee_contact
       std::ostringstream    muparser_output;
       std::streambuf *const cerr_buffer =
         std::cerr.rdbuf(muparser_output.rdbuf());
+      Vector<double> values(n_components);
       try
         {
           function->initialize("x,y", parts, constant_map);
-          Vector<double> values(n_components);
           function->vector_value(Point<2>(0.123456789, 0.234567891), values);
           std::cerr.rdbuf(cerr_buffer);
         }
@@ -146,6 +146,13 @@ namespace knee_contact
                                  expression + "' (" + one_line(exc.what()) +
                                  ")"));
         }
+      // A value that is not finite at a generic point is a mistake (1/0,
+      // log(0)), not a singularity the scene means.
+      for (unsigned int c = 0; c < n_components; ++c)
+        AssertThrow(std::isfinite(values(c)),
+                    ExcMessage("parameter '" + parameter + "': '" + expression +
+                               "' is not finite (inf or nan) at (x, y) = "
+                               "(0.123456789, 0.234567891)"));
       return function;
     }
 
