@@ -16,6 +16,9 @@ namespace knee_contact
                     QGauss<2>(fe.degree + 1),
                     update_values | update_gradients |
                       update_quadrature_points | update_JxW_values)
+        , fe_values_reduced(fe,
+                            QGauss<2>(fe.degree),
+                            update_gradients | update_JxW_values)
         , fe_face_values(fe,
                          QGauss<1>(fe.degree + 1),
                          update_values | update_quadrature_points |
@@ -26,12 +29,16 @@ namespace knee_contact
         : fe_values(other.fe_values.get_fe(),
                     other.fe_values.get_quadrature(),
                     other.fe_values.get_update_flags())
+        , fe_values_reduced(other.fe_values_reduced.get_fe(),
+                            other.fe_values_reduced.get_quadrature(),
+                            other.fe_values_reduced.get_update_flags())
         , fe_face_values(other.fe_face_values.get_fe(),
                          other.fe_face_values.get_quadrature(),
                          other.fe_face_values.get_update_flags())
       {}
 
       FEValues<2>     fe_values;
+      FEValues<2>     fe_values_reduced;
       FEFaceValues<2> fe_face_values;
     };
 
@@ -91,15 +98,29 @@ namespace knee_contact
                   const Tensor<1, 2> gj = fev.shape_grad(j, q);
                   // c_ijkl for isotropic material, written per component
                   // pair as in step-8.
+                  const double lambda =
+                    material.reduced_volumetric ? 0. : material.lambda;
                   copy.cell_matrix(i, j) +=
-                    (gi[ci] * gj[cj] * material.lambda +
-                     gi[cj] * gj[ci] * material.mu +
+                    (gi[ci] * gj[cj] * lambda + gi[cj] * gj[ci] * material.mu +
                      (ci == cj ? gi * gj * material.mu : 0.)) *
                     fev.JxW(q);
                 }
               copy.cell_rhs(i) +=
                 fev.shape_value(i, q) * force(ci) * fev.JxW(q);
             }
+        }
+
+      if (material.reduced_volumetric)
+        {
+          scratch.fe_values_reduced.reinit(cell);
+          const FEValues<2> &fer = scratch.fe_values_reduced;
+          for (const unsigned int q : fer.quadrature_point_indices())
+            for (unsigned int i = 0; i < n; ++i)
+              for (unsigned int j = 0; j < n; ++j)
+                copy.cell_matrix(i, j) +=
+                  fer.shape_grad(i, q)[fe.system_to_component_index(i).first] *
+                  fer.shape_grad(j, q)[fe.system_to_component_index(j).first] *
+                  material.lambda * fer.JxW(q);
         }
 
       for (const unsigned int f : cell->face_indices())

@@ -69,6 +69,13 @@ namespace knee_contact
                           "0.3",
                           Patterns::Double(),
                           "Poisson's ratio nu, in (-1, 0.5).");
+        prm.declare_entry("Volumetric integration",
+                          "full",
+                          Patterns::Selection("full|reduced"),
+                          "full: 2x2 Gauss points for the whole stiffness; "
+                          "reduced: the volumetric part lambda div u div v "
+                          "with one point (selective reduced integration), "
+                          "against locking when nu is close to 0.5.");
         prm.declare_entry("Body force",
                           "0; 0",
                           Patterns::Anything(),
@@ -102,8 +109,10 @@ namespace knee_contact
         material.youngs_modulus = prm.get_double("Young's modulus");
         material.poissons_ratio = prm.get_double("Poisson's ratio");
         material.plane_strain   = plane_strain;
-        const double E          = material.youngs_modulus;
-        const double nu         = material.poissons_ratio;
+        material.reduced_volumetric =
+          prm.get("Volumetric integration") == "reduced";
+        const double E  = material.youngs_modulus;
+        const double nu = material.poissons_ratio;
         AssertThrow(std::isfinite(E) && E > 0,
                     ExcMessage("Materials/" + section +
                                "/Young's modulus: E must be > 0, got " +

@@ -21,12 +21,18 @@ namespace knee_contact
    */
   struct Material
   {
-    std::string                        name;
-    double                             youngs_modulus = 0;
-    double                             poissons_ratio = 0;
-    double                             lambda         = 0;
-    double                             mu             = 0;
-    bool                               plane_strain   = true;
+    std::string name;
+    double      youngs_modulus = 0;
+    double      poissons_ratio = 0;
+    double      lambda         = 0;
+    double      mu             = 0;
+    bool        plane_strain   = true;
+    /**
+     * Selective reduced integration: the volumetric part lambda div u div v
+     * with one Gauss point per cell, the standard remedy for the locking of
+     * Q1 elements as nu approaches 1/2.
+     */
+    bool                               reduced_volumetric = false;
     std::unique_ptr<FunctionParser<2>> body_force;
 
     /**
