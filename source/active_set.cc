@@ -38,6 +38,13 @@ namespace knee_contact
                       "relative complementarity residual max_p |min(lambda_p "
                       "/ max lambda, (g_p - (A x)_p) / max |u|)| is below "
                       "this.");
+    prm.declare_entry("Cycle safeguard",
+                      "true",
+                      Patterns::Bool(),
+                      "When the active set returns to an earlier set, go on "
+                      "releasing at most one pair per iteration (the most "
+                      "negative lambda) while adding every penetrating pair; "
+                      "false: stop with converged = false.");
     prm.leave_subsection();
   }
 
@@ -51,6 +58,7 @@ namespace knee_contact
     max_iterations = prm.get_integer("Maximum active set iterations");
     c              = prm.get_double("Active set constant") * max_youngs_modulus;
     tolerance      = prm.get_double("Tolerance");
+    safeguard      = prm.get_bool("Cycle safeguard");
     AssertThrow(c > 0, ExcMessage("Contact/Active set constant must be > 0"));
     prm.leave_subsection();
   }
@@ -331,6 +339,25 @@ namespace knee_contact
             n_entered += next[p] && !result.active[p];
             n_left += !next[p] && result.active[p];
           }
+        // Safeguard after a cycle: of the pairs the test releases, release
+        // only the one with the most negative multiplier.
+        const auto release_one = [&]() {
+          unsigned int release = numbers::invalid_unsigned_int;
+          for (unsigned int p = 0; p < n_pairs; ++p)
+            if (result.active[p] && !next[p] &&
+                (release == numbers::invalid_unsigned_int ||
+                 result.lambda[p] < result.lambda[release]))
+              release = p;
+          for (unsigned int p = 0; p < n_pairs; ++p)
+            if (result.active[p] && !next[p] && p != release)
+              {
+                next[p] = true;
+                ++n_active;
+                --n_left;
+              }
+        };
+        if (result.safeguard_from > 0)
+          release_one();
         result.n_iterations = iteration;
         log << "   active set iteration " << std::setw(2) << iteration << ": "
             << std::setw(5) << n_active << " active pairs (+" << n_entered
@@ -348,13 +375,24 @@ namespace knee_contact
                                "Contact/Tolerance";
             return result;
           }
+        if (seen.count(next) && safeguard && result.safeguard_from == 0)
+          {
+            // Switch the safeguard on and forget the history: from here on
+            // the set changes by one release at a time.
+            result.safeguard_from = iteration;
+            log << "   active set cycle at iteration " << iteration
+                << ": releasing at most one pair per iteration from now on"
+                << std::endl;
+            seen.clear();
+            release_one();
+          }
         if (seen.count(next))
           {
             result.converged = false;
             result.failure =
               "the active set cycles (iteration " + std::to_string(iteration) +
-              " returns to an earlier set); try a smaller 'Active set "
-              "constant' or a finer mesh at the contact";
+              " returns to an earlier set); make the finer side the slave, "
+              "or refine the coarse side of the interface";
             return result;
           }
         if (iteration >= max_iterations)

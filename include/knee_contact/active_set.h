@@ -29,10 +29,12 @@ namespace knee_contact
     std::vector<bool>   active;
     std::vector<double> lambda; // contact force of each pair [N/m], >= 0
     unsigned int        n_iterations = 0;
-    bool                converged    = true;
-    std::string         failure; // why not, if not converged
-    double              complementarity = 0;
-    double              max_penetration = 0; // max (A x - g)_p [m]
+    /** Iteration at which a cycle switched on the safeguard; 0: never. */
+    unsigned int safeguard_from = 0;
+    bool         converged      = true;
+    std::string  failure; // why not, if not converged
+    double       complementarity = 0;
+    double       max_penetration = 0; // max (A x - g)_p [m]
   };
 
 
@@ -107,6 +109,7 @@ namespace knee_contact
     unsigned int max_iterations = 50;
     double       c              = 0;
     double       tolerance      = 1e-10;
+    bool         safeguard      = true;
   };
 } // namespace knee_contact
 
