@@ -193,7 +193,9 @@ namespace knee_contact
           {
             if (space)
               line += ' ';
-            line += c;
+            // Control characters (from a binary file) would garble the
+            // terminal.
+            line += (static_cast<unsigned char>(c) < 32 || c == 127) ? '?' : c;
             space = false;
           }
       // Strip a line of dashes deal.II adds around its messages.

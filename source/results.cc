@@ -55,7 +55,16 @@ namespace knee_contact
           support_force(line.index) = 0;
         }
     }
-    results.energy           = matrix.matrix_norm_square(solution);
+    // a(u,u) = x^T C x, summed in a fixed order: SparseMatrix's own
+    // matrix_norm_square() is a threaded reduction whose last bit varies
+    // from run to run.
+    {
+      Vector<double> product(solution.size());
+      matrix.vmult(product, solution);
+      results.energy = 0;
+      for (unsigned int i = 0; i < solution.size(); ++i)
+        results.energy += solution(i) * product(i);
+    }
     results.max_displacement = solution.linfty_norm();
 
     // Applied load and reactions by vertex, each vertex once.

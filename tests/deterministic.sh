@@ -26,7 +26,16 @@ done
 if cmp -s "$work/a.json" "$work/b.json" && cmp -s "$work/a.json" "$work/c.json"; then
   echo "PASS: summary.json identical across 2 runs with 2 threads and 1 run with 1 thread"
 else
-  diff "$work/a.json" "$work/c.json" | head -5
+  /usr/bin/python3 -c '
+import json, sys
+runs = [json.loads(open(f).read()) for f in sys.argv[1:]]
+def walk(a, others, path):
+    if isinstance(a, dict):
+        for k in a:
+            walk(a[k], [o[k] for o in others], path + "/" + k)
+    elif any(o != a for o in others):
+        print("differs:", path, a, others)
+walk(runs[0], runs[1:], "")' "$work/a.json" "$work/b.json" "$work/c.json"
   echo "FAIL: results differ between runs"
   exit 1
 fi
