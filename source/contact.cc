@@ -161,8 +161,8 @@ namespace knee_contact
       Tensor<1, 2>                                          normal;
     };
 
-    // Outward unit normal of a boundary face of a cell (times the face
-    // length, if @p scaled).
+    // Outward normal of a boundary face of a cell, with the face's length
+    // as its norm (so that summing over a vertex's faces weights by length).
     Tensor<1, 2>
     outward_normal(const DoFHandler<2>::active_cell_iterator &cell,
                    const unsigned int                         f)

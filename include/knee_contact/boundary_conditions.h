@@ -60,10 +60,10 @@ namespace knee_contact
 
     /**
      * Constraints of Gamma_u and Gamma_o (the seed's eq. (13), first three
-     * lines). Gamma_o uses deal.II's no-normal-flux constraints, which
-     * rotate the constraint to the averaged vertex normal on slanted and
-     * curved boundaries. Where a vertex lies on Gamma_u and Gamma_o,
-     * Gamma_u wins.
+     * lines), after the hanging-node constraints of adaptive meshes.
+     * Gamma_o uses deal.II's no-normal-flux constraints, which rotate the
+     * constraint to the averaged vertex normal on slanted and curved
+     * boundaries. Where a vertex lies on Gamma_u and Gamma_o, Gamma_u wins.
      */
     void
     make_constraints(const DoFHandler<2>       &dof_handler,
