@@ -5,8 +5,12 @@
 #include <deal.II/grid/grid_refinement.h>
 #include <deal.II/numerics/error_estimator.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
+#include <utility>
+#include <vector>
 
 namespace knee_contact
 {
@@ -133,24 +137,53 @@ namespace knee_contact
                 if (face->boundary_id() ==
                     (k == 0 ? interface.slave_id : interface.master_id))
                   sides[k].push_back({cell, face->center(), face->measure()});
-        // A marked face of length h becomes h/2; an opposite face that
-        // overlaps it (centres closer than half their lengths plus a face)
-        // and is longer than h is marked too.
+        // Facing faces: centres closer than half the sum of their lengths.
+        // Found once through a grid as fine as the longest face (so only
+        // neighbouring grid cells can hold a partner), then swept until no
+        // flag changes: a marked face of length h becomes h/2, and a facing
+        // face longer than 0.75 h is marked too.
+        double h = 0;
+        for (const auto &side : sides)
+          for (const Side &face : side)
+            h = std::max(h, face.length);
+        std::map<std::pair<long, long>, std::vector<unsigned int>> grid;
+        const auto key = [h](const Point<2> &p) {
+          return std::make_pair(std::lround(std::floor(p[0] / h)),
+                                std::lround(std::floor(p[1] / h)));
+        };
+        for (unsigned int j = 0; j < sides[1].size(); ++j)
+          grid[key(sides[1][j].centre)].push_back(j);
+        std::vector<std::pair<unsigned int, unsigned int>> facing;
+        for (unsigned int i = 0; i < sides[0].size(); ++i)
+          {
+            const auto [x, y] = key(sides[0][i].centre);
+            for (long dx = -1; dx <= 1; ++dx)
+              for (long dy = -1; dy <= 1; ++dy)
+                {
+                  const auto it = grid.find({x + dx, y + dy});
+                  if (it != grid.end())
+                    for (const unsigned int j : it->second)
+                      if (sides[0][i].centre.distance(sides[1][j].centre) <
+                          0.5 * (sides[0][i].length + sides[1][j].length))
+                        facing.emplace_back(i, j);
+                }
+          }
         for (bool changed = true; changed;)
           {
             changed = false;
-            for (unsigned int k = 0; k < 2; ++k)
-              for (const Side &marked : sides[k])
-                if (marked.cell->refine_flag_set())
-                  for (const Side &other : sides[1 - k])
-                    if (!other.cell->refine_flag_set() &&
-                        other.length > 0.75 * marked.length &&
-                        other.centre.distance(marked.centre) <
-                          0.5 * (other.length + marked.length))
-                      {
-                        other.cell->set_refine_flag();
-                        changed = true;
-                      }
+            for (const auto &[i, j] : facing)
+              for (unsigned int k = 0; k < 2; ++k)
+                {
+                  const Side &marked = k == 0 ? sides[0][i] : sides[1][j];
+                  const Side &other  = k == 0 ? sides[1][j] : sides[0][i];
+                  if (marked.cell->refine_flag_set() &&
+                      !other.cell->refine_flag_set() &&
+                      other.length > 0.75 * marked.length)
+                    {
+                      other.cell->set_refine_flag();
+                      changed = true;
+                    }
+                }
           }
       }
   }
