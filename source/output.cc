@@ -1,9 +1,6 @@
 #include <knee_contact/input.h>
 #include <knee_contact/output.h>
 
-#include <deal.II/base/quadrature_lib.h>
-
-#include <deal.II/fe/fe_values.h>
 #include <deal.II/numerics/data_out.h>
 #include <deal.II/numerics/data_postprocessor.h>
 
@@ -221,15 +218,8 @@ namespace knee_contact
   OutputWriter::write_cells(const DoFHandler<2>             &dof_handler,
                             const std::vector<unsigned int> &body_of_cell,
                             const Vector<double>            &solution,
-                            const Materials                 &materials) const
+                            const Results                   &results) const
   {
-    // tau_yy from the displacement gradient at each vertex of each cell.
-    FEValues<2>                        fe_values(dof_handler.get_fe(),
-                          QTrapezoid<2>(),
-                          update_values | update_gradients);
-    const FEValuesExtractors::Vector   u(0);
-    std::vector<Tensor<1, 2>>          values(4);
-    std::vector<SymmetricTensor<2, 2>> strains(4);
     write_atomically(output_folder + "/cells.csv", [&](std::ostream &out) {
       out << "material_id,body_id";
       for (unsigned int v = 0; v < 4; ++v)
@@ -238,18 +228,14 @@ namespace knee_contact
       out << '\n' << std::setprecision(9);
       for (const auto &cell : dof_handler.active_cell_iterators())
         {
-          fe_values.reinit(cell);
-          fe_values[u].get_function_values(solution, values);
-          fe_values[u].get_function_symmetric_gradients(solution, strains);
-          const Material &material = materials[cell->material_id()];
           out << static_cast<unsigned int>(cell->material_id()) << ','
               << body_of_cell[cell->active_cell_index()];
-          // QTrapezoid's points are the vertices in deal.II's order; write
-          // them counter-clockwise.
+          // Counter-clockwise: deal.II's vertex order is 0 1 3 2.
           for (const unsigned int v : {0u, 1u, 3u, 2u})
             out << ',' << cell->vertex(v)[0] << ',' << cell->vertex(v)[1] << ','
-                << values[v][0] << ',' << values[v][1] << ','
-                << material.stress(strains[v])[1][1];
+                << solution(cell->vertex_dof_index(v, 0)) << ','
+                << solution(cell->vertex_dof_index(v, 1)) << ','
+                << results.vertex_stress_yy[cell->active_cell_index()][v];
           out << '\n';
         }
     });

@@ -341,7 +341,7 @@ namespace knee_contact
         output_writer.write_cells(dof_handler,
                                   body_of_cell,
                                   displacement,
-                                  materials);
+                                  results);
         output_writer.write_contact_csv(contact_interfaces,
                                         contact_pairs,
                                         displacement,

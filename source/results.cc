@@ -120,6 +120,7 @@ namespace knee_contact
                           update_gradients);
     std::vector<SymmetricTensor<2, 2>> strains(4);
     const FEValuesExtractors::Vector   displacement(0);
+    results.vertex_stress_yy.resize(results.n_cells);
     for (const auto &cell : dof_handler.active_cell_iterators())
       {
         fe_values.reinit(cell);
@@ -130,9 +131,10 @@ namespace knee_contact
           cell->material_id(),
           std::make_pair(std::numeric_limits<double>::max(),
                          -std::numeric_limits<double>::max()));
-        for (const auto &strain : strains)
+        for (unsigned int v = 0; v < 4; ++v)
           {
-            const double syy = material.stress(strain)[1][1];
+            const double syy = material.stress(strains[v])[1][1];
+            results.vertex_stress_yy[cell->active_cell_index()][v] = syy;
             range.first->second.first =
               std::min(range.first->second.first, syy);
             range.first->second.second =

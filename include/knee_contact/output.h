@@ -65,7 +65,7 @@ namespace knee_contact
     write_cells(const DoFHandler<2>             &dof_handler,
                 const std::vector<unsigned int> &body_of_cell,
                 const Vector<double>            &solution,
-                const Materials                 &materials) const;
+                const Results                   &results) const;
 
     /**
      * Run scripts/@p script (Debian's python3 with matplotlib) on the

@@ -11,6 +11,7 @@
 
 #include <deal.II/dofs/dof_handler.h>
 
+#include <array>
 #include <map>
 #include <string>
 #include <vector>
@@ -51,6 +52,11 @@ namespace knee_contact
     /** a(u, u) [J/m]. */
     double energy           = 0;
     double max_displacement = 0;
+    /**
+     * tau_yy [Pa] at the four vertices of each active cell (by
+     * active_cell_index(), deal.II's vertex order): what the pictures show.
+     */
+    std::vector<std::array<double, 4>> vertex_stress_yy;
     /** min and max tau_yy per material id [Pa], at cell vertices. */
     std::map<types::material_id, std::pair<double, double>> stress_yy_range;
     std::vector<InterfaceResult>                            interfaces;
