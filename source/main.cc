@@ -1,10 +1,13 @@
 #include <knee_contact/input.h>
+#include <knee_contact/interruption.h>
 #include <knee_contact/problem.h>
 
 #include <deal.II/base/multithread_info.h>
 
 #include <cstring>
 #include <iostream>
+#include <new>
+#include <stdexcept>
 
 // knee_contact: unilateral contact between linear elastic bodies in 2D.
 // Usage: knee_contact [--dry-run] scene.prm | --help | --print-parameters
@@ -20,6 +23,7 @@ main(int argc, char **argv)
     "       knee_contact --print-parameters   every parameter with its "
     "documentation and default\n"
     "       knee_contact --help\n";
+  interruption::install();
   try
     {
       if (argc == 2 && (std::strcmp(argv[1], "--help") == 0 ||
@@ -51,7 +55,10 @@ main(int argc, char **argv)
       ContactProblem problem(argv[1]);
       return problem.run();
     }
-  catch (const dealii::ExceptionBase &exc)
+  // A message built for the user (ExcMessage from AssertThrow, or a
+  // runtime_error of the input checks) is bad input; out of memory is said
+  // as such; anything else is a bug of the program.
+  catch (const dealii::StandardExceptions::ExcMessage &exc)
     {
       std::ostringstream info;
       exc.print_info(info);
@@ -59,15 +66,43 @@ main(int argc, char **argv)
                 << std::endl;
       return ExitCode::input_error;
     }
-  catch (const std::exception &exc)
+  catch (const std::bad_alloc &)
+    {
+      std::cerr << "knee_contact: error: out of memory (the mesh or the "
+                   "factorisation needs more than this machine has; use "
+                   "fewer refinements or a coarser mesh)"
+                << std::endl;
+      return ExitCode::input_error;
+    }
+  catch (const dealii::ExceptionBase &exc)
+    {
+      std::ostringstream info;
+      exc.print_info(info);
+      std::cerr << "knee_contact: internal error (a bug; please report it "
+                   "with the scene file): "
+                << input::one_line(exc.get_exc_name() + std::string(": ") +
+                                   info.str())
+                << std::endl;
+      return ExitCode::internal_error;
+    }
+  catch (const std::runtime_error &exc)
     {
       std::cerr << "knee_contact: error: " << input::one_line(exc.what())
                 << std::endl;
       return ExitCode::input_error;
     }
+  catch (const std::exception &exc)
+    {
+      std::cerr << "knee_contact: internal error (a bug; please report it "
+                   "with the scene file): "
+                << input::one_line(exc.what()) << std::endl;
+      return ExitCode::internal_error;
+    }
   catch (...)
     {
-      std::cerr << "knee_contact: error: unknown exception" << std::endl;
-      return ExitCode::input_error;
+      std::cerr << "knee_contact: internal error (a bug; please report it "
+                   "with the scene file): unknown exception"
+                << std::endl;
+      return ExitCode::internal_error;
     }
 }

@@ -1,4 +1,6 @@
+#include <knee_contact/gmsh_input.h>
 #include <knee_contact/input.h>
+#include <knee_contact/interruption.h>
 #include <knee_contact/mesh.h>
 
 #include <deal.II/grid/grid_in.h>
@@ -35,7 +37,15 @@ namespace knee_contact
                       "",
                       Patterns::Anything(),
                       "Extra arguments for the gmsh program when File is a "
-                      ".geo, e.g. '-setnumber lc 0.002' or '-clscale 0.5'.");
+                      ".geo, e.g. '-setnumber lc 0.002' or '-clscale 0.5': "
+                      "words, never a command line; only -setnumber NAME "
+                      "NUMBER, -clscale, -clmin, -clmax, -clcurv and -smooth "
+                      "NUMBER are accepted.");
+    prm.declare_entry("Gmsh time limit",
+                      "300",
+                      Patterns::Double(1),
+                      "Seconds gmsh may take to mesh a .geo before it is "
+                      "stopped and the run refused [s].");
     prm.declare_entry(
       "Rectangles",
       "0, 0, 1, 1, 1, 1, 1, 0, 1, 2, 3, 4",
@@ -71,7 +81,8 @@ namespace knee_contact
     prm.enter_subsection("Mesh");
     source = prm.get("Source") == "file" ? Source::file : Source::rectangles;
     file   = input::resolve_path(prm.get("File"), scene_file);
-    gmsh_arguments   = prm.get("Gmsh arguments");
+    gmsh_arguments   = gmsh_input::arguments(prm.get("Gmsh arguments"));
+    gmsh_time_limit  = prm.get_double("Gmsh time limit");
     rotation_degrees = prm.get_double("Rotation angle");
     n_refinements    = prm.get_integer("Global refinements");
     AssertThrow(std::isfinite(rotation_degrees),
@@ -233,34 +244,44 @@ namespace knee_contact
     if (std::filesystem::path(file).extension() == ".geo")
       {
         // Mesh the .geo with the gmsh program into a private temporary
-        // folder; msh2 is the format GridIn reads most robustly.
+        // folder (removed on Ctrl-C too); msh2 is the format GridIn reads
+        // most robustly.
         std::string folder =
           (std::filesystem::temp_directory_path() / "knee_contact_XXXXXX")
             .string();
         AssertThrow(mkdtemp(folder.data()) != nullptr,
                     ExcMessage("cannot create a temporary folder for gmsh"));
-        temporary_folder          = folder;
-        msh                       = folder + "/mesh.msh";
-        const std::string log     = folder + "/gmsh.log";
-        const std::string command = "gmsh -2 -format msh2 -v 2 " +
-                                    gmsh_arguments + " -o '" + msh + "' '" +
-                                    file + "' > '" + log + "' 2>&1";
-        const int   status = std::system(command.c_str());
-        std::string first_error;
-        {
-          std::ifstream in(log);
-          for (std::string line; std::getline(in, line);)
-            if (line.find("rror") != std::string::npos && first_error.empty())
-              first_error = line;
-        }
-        if (status != 0 || !std::ifstream(msh).good() || !first_error.empty())
+        temporary_folder = folder;
+        interruption::register_folder(temporary_folder);
+        msh = folder + "/mesh.msh";
+        try
           {
-            std::filesystem::remove_all(temporary_folder);
-            AssertThrow(false,
-                        ExcMessage(
-                          "Mesh/File: gmsh cannot mesh '" + file + "'" +
-                          (first_error.empty() ? "" : ": " + first_error)));
+            gmsh_input::mesh(file, msh, gmsh_arguments, gmsh_time_limit);
           }
+        catch (...)
+          {
+            interruption::unregister_folder(temporary_folder);
+            std::filesystem::remove_all(temporary_folder);
+            throw;
+          }
+      }
+    const auto remove_temporary = [&]() {
+      if (!temporary_folder.empty())
+        {
+          interruption::unregister_folder(temporary_folder);
+          std::filesystem::remove_all(temporary_folder);
+        }
+    };
+
+    // deal.II's reader trusts its input; check the file first.
+    try
+      {
+        gmsh_input::check_msh(msh);
+      }
+    catch (const std::exception &exc)
+      {
+        remove_temporary();
+        AssertThrow(false, ExcMessage(exc.what()));
       }
 
     GridIn<2> grid_in;
@@ -272,15 +293,13 @@ namespace knee_contact
       }
     catch (const std::exception &exc)
       {
-        if (!temporary_folder.empty())
-          std::filesystem::remove_all(temporary_folder);
+        remove_temporary();
         AssertThrow(false,
                     ExcMessage("Mesh/File: cannot read '" + file +
                                "' as a Gmsh mesh (" +
                                input::one_line(exc.what()) + ")"));
       }
-    if (!temporary_folder.empty())
-      std::filesystem::remove_all(temporary_folder);
+    remove_temporary();
     AssertThrow(triangulation.all_reference_cells_are_hyper_cube(),
                 ExcMessage("Mesh/File: '" + file +
                            "' has triangles; knee_contact needs "

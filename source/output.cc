@@ -1,3 +1,4 @@
+#include <knee_contact/external_program.h>
 #include <knee_contact/input.h>
 #include <knee_contact/output.h>
 
@@ -8,33 +9,57 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iomanip>
+#include <iostream>
 
 namespace knee_contact
 {
   namespace
   {
-    // Write through a temporary file and rename it over @p file.
+    // Write @p file; the whole folder is swapped in at the end
+    // (ResultFolder), so a failed write only has to be reported.
     void
-    write_atomically(const std::string                         &file,
-                     const std::function<void(std::ostream &)> &write)
+    write_checked(const std::string                         &file,
+                  const std::function<void(std::ostream &)> &write)
     {
-      const std::string temporary = file + ".part";
-      {
-        std::ofstream out(temporary);
-        AssertThrow(out.good(), ExcMessage("cannot write '" + temporary + "'"));
-        write(out);
-        out.flush();
-        AssertThrow(out.good(),
-                    ExcMessage("writing '" + temporary + "' failed"));
-      }
-      std::filesystem::rename(temporary, file);
+      std::ofstream out(file);
+      AssertThrow(out.good(),
+                  ExcMessage("cannot write '" + file +
+                             "': " + std::strerror(errno)));
+      write(out);
+      out.close();
+      AssertThrow(!out.fail(),
+                  ExcMessage("writing '" + file + "' failed: " +
+                             (errno == ENOSPC ? std::string("no space left "
+                                                            "on the device") :
+                                                std::strerror(errno))));
     }
 
+
+
+    // The picture scripts: beside the binary in the build tree
+    // (<bin>/scripts), or under <prefix>/share/knee_contact/scripts when
+    // installed; found through /proc/self/exe, so a moved or installed
+    // build still draws pictures.
+    std::string
+    find_script(const std::string &name)
+    {
+      std::error_code             code;
+      const std::filesystem::path binary =
+        std::filesystem::read_symlink("/proc/self/exe", code);
+      const std::filesystem::path bin = binary.parent_path();
+      for (const auto &candidate :
+           {bin / "scripts" / name,
+            bin / ".." / "share" / "knee_contact" / "scripts" / name})
+        if (std::filesystem::exists(candidate, code))
+          return candidate.lexically_normal().string();
+      return "";
+    }
     // tau_xx, tau_yy, tau_xy and von Mises of each cell's material, from the
     // displacement gradient.
     class StressPostprocessor : public DataPostprocessor<2>
@@ -116,6 +141,12 @@ namespace knee_contact
                       Patterns::Anything(),
                       "Points labelled in deformation.png: 'name: x, y; ...' "
                       "[m], e.g. the seed's points 1-10.");
+    prm.declare_entry("Picture time limit",
+                      "600",
+                      Patterns::Double(1),
+                      "Seconds the picture script may take before it is "
+                      "stopped (the result set is then kept without "
+                      "pictures, with a warning).");
     prm.declare_entry("Write files",
                       "true",
                       Patterns::Bool(),
@@ -138,6 +169,7 @@ namespace knee_contact
     terminal_test = prm.get("Terminal") == "test";
     write_files   = prm.get_bool("Write files");
     pictures      = prm.get_bool("Pictures");
+    picture_time_limit = prm.get_double("Picture time limit");
     for (const auto &[name, point] :
          input::split_named(prm.get("Labels"), "Output/Labels", "name: x, y"))
       labels.emplace_back(name, input::to_point(point, "Output/Labels"));
@@ -147,17 +179,38 @@ namespace knee_contact
 
 
   void
-  OutputWriter::prepare() const
+  OutputWriter::prepare()
   {
-    if (!write_files)
-      return;
-    std::error_code error;
-    std::filesystem::create_directories(output_folder, error);
-    const std::string probe = output_folder + "/.write_test";
-    AssertThrow(!error && std::ofstream(probe).good(),
-                ExcMessage("Output/Folder: cannot write to '" + output_folder +
-                           "'"));
-    std::filesystem::remove(probe);
+    if (write_files)
+      result_folder = std::make_unique<ResultFolder>(output_folder);
+  }
+
+
+
+  void
+  OutputWriter::commit()
+  {
+    if (result_folder)
+      result_folder->commit();
+    result_folder.reset();
+  }
+
+
+
+  void
+  OutputWriter::warn(const std::string &message)
+  {
+    std::cout << "warning: " << message << std::endl;
+    warnings.push_back(message);
+  }
+
+
+
+  std::string
+  OutputWriter::staging(const std::string &name) const
+  {
+    Assert(result_folder, ExcInternalError());
+    return result_folder->staging() + "/" + name;
   }
 
 
@@ -208,7 +261,7 @@ namespace knee_contact
     data_out.add_data_vector(material_id, "material_id");
     data_out.add_data_vector(body_id, "body_id");
     data_out.build_patches();
-    write_atomically(output_folder + "/solution.vtu",
+    write_checked(staging("solution.vtu"),
                      [&](std::ostream &out) { data_out.write_vtu(out); });
   }
 
@@ -220,7 +273,7 @@ namespace knee_contact
                             const Vector<double>            &solution,
                             const Results                   &results) const
   {
-    write_atomically(output_folder + "/cells.csv", [&](std::ostream &out) {
+    write_checked(staging("cells.csv"), [&](std::ostream &out) {
       out << "material_id,body_id";
       for (unsigned int v = 0; v < 4; ++v)
         for (const char *name : {"x", "y", "u_x", "u_y", "stress_yy"})
@@ -248,7 +301,7 @@ namespace knee_contact
     const std::string                         &name,
     const std::function<void(std::ostream &)> &write) const
   {
-    write_atomically(output_folder + "/" + name, write);
+    write_checked(staging(name), write);
   }
 
 
@@ -259,20 +312,28 @@ namespace knee_contact
   {
     if (!write_files || !pictures)
       return true;
-    const std::string script =
-      std::string(KNEE_CONTACT_SOURCE_DIR) + "/scripts/" + script_name;
-    const std::string log     = output_folder + "/pictures.log";
-    const std::string command = "/usr/bin/python3 '" + script + "' '" +
-                                output_folder + "' > '" + log + "' 2>&1";
-    if (std::system(command.c_str()) == 0)
+    const std::string script = find_script(script_name);
+    if (script.empty())
       {
-        std::filesystem::remove(log);
-        return true;
+        message = "scripts/" + script_name +
+                  " is neither beside the program nor in "
+                  "share/knee_contact/scripts";
+        return false;
       }
-    std::ifstream in(log);
-    std::string   line;
-    while (std::getline(in, line))
-      message = line;
+    // An argument vector, no shell: the folder name is data.
+    const std::string   log = staging("pictures.log");
+    const ProgramResult result =
+      run_program({"/usr/bin/python3", script, result_folder->staging()},
+                  log,
+                  picture_time_limit);
+    std::filesystem::remove(log);
+    if (result.exit_code == 0)
+      return true;
+    message = describe_failure(result,
+                               "python3 " + script_name,
+                               output_folder,
+                               "Output/Picture time limit",
+                               picture_time_limit);
     return false;
   }
 
@@ -312,8 +373,8 @@ namespace knee_contact
           name.end(),
           [](const char c) { return !std::isalnum(c) && c != '-'; },
           '_');
-        write_atomically(
-          output_folder + "/contact_" + name + ".csv", [&](std::ostream &out) {
+        write_checked(
+          staging("contact_" + name + ".csv"), [&](std::ostream &out) {
             out << "arc_length,x,y,n_x,n_y,gap,jump,pressure,active\n"
                 << std::setprecision(10);
             double s = 0;
@@ -385,9 +446,11 @@ namespace knee_contact
       summary["labels"][name] = {point[0], point[1]};
     if (!contact.converged)
       summary["failure"] = contact.failure;
+    if (!warnings.empty())
+      summary["warnings"] = warnings;
     for (const auto &[phase, seconds] : wall_times)
       summary["wall_time"][phase] = seconds;
-    write_atomically(output_folder + "/summary.json", [&](std::ostream &out) {
+    write_checked(staging("summary.json"), [&](std::ostream &out) {
       out << summary.dump(2) << '\n';
     });
   }

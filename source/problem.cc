@@ -355,20 +355,32 @@ namespace knee_contact
             write_study_csv(all, out);
           });
       }
-    auto wall_times = timer.get_summary_data(TimerOutput::total_wall_time);
     if (output_writer.enabled())
       {
-        output_writer.write_summary(results,
-                                    contact_solution,
-                                    materials,
-                                    wall_times);
+        // The pictures read summary.json; a picture failure is kept in it
+        // as a warning.
+        output_writer.write_summary(
+          results,
+          contact_solution,
+          materials,
+          timer.get_summary_data(TimerOutput::total_wall_time));
         TimerOutput::Scope scope(timer, "pictures");
         std::string        message;
         if (!output_writer.run_script("plot_results.py", message) ||
             (sequences.size() > 1 &&
              !output_writer.run_script("plot_study.py", message)))
-          std::cout << "warning: no pictures: " << message << std::endl;
+          {
+            output_writer.warn("no pictures: " + message);
+            output_writer.write_summary(
+              results,
+              contact_solution,
+              materials,
+              timer.get_summary_data(TimerOutput::total_wall_time));
+          }
       }
+    const auto wall_times =
+      timer.get_summary_data(TimerOutput::total_wall_time);
+    output_writer.commit();
     if (!output_writer.test_mode())
       {
         std::cout << "wall time [s]:";

@@ -4,6 +4,7 @@
 #include <knee_contact/active_set.h>
 #include <knee_contact/contact.h>
 #include <knee_contact/materials.h>
+#include <knee_contact/result_folder.h>
 #include <knee_contact/results.h>
 
 #include <deal.II/base/parameter_handler.h>
@@ -14,6 +15,7 @@
 
 #include <functional>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -23,9 +25,9 @@ namespace knee_contact
 
   /**
    * The files of a run, in the output folder: solution.vtu, one
-   * contact_<interface>.csv per interface and summary.json. Each file is
-   * written to a temporary name and renamed, so a run that fails never
-   * leaves a half-written file over a good one.
+   * contact_<interface>.csv per interface and summary.json. All files of a
+   * run go into a staging folder that replaces the output folder in one
+   * step at the end (ResultFolder), so the folder never mixes two runs.
    */
   class OutputWriter
   {
@@ -36,9 +38,18 @@ namespace knee_contact
     void
     parse_parameters(ParameterHandler &prm, const std::string &scene_file);
 
-    /** Create the folder; throw a one-line error if it cannot be written. */
+    /**
+     * Lock the output folder and create the run's staging folder beside it
+     * (ResultFolder); throw a one-line error if either is impossible.
+     */
     void
-    prepare() const;
+    prepare();
+
+    /**
+     * Swap the complete result set in for the output folder's previous one.
+     */
+    void
+    commit();
 
     void
     write_vtu(const DoFHandler<2>             &dof_handler,
@@ -77,7 +88,7 @@ namespace knee_contact
     run_script(const std::string &script, std::string &message) const;
 
     /**
-     * Write the file @p name in the folder through a temporary file.
+     * Write the file @p name into the run's staging folder.
      */
     void
     write_file(const std::string                         &name,
@@ -88,6 +99,13 @@ namespace knee_contact
                   const ContactSolution               &contact,
                   const Materials                     &materials,
                   const std::map<std::string, double> &wall_times) const;
+
+    /**
+     * Print a warning on the terminal and keep it for summary.json
+     * ("warnings"): for what is suspicious but not refused.
+     */
+    void
+    warn(const std::string &message);
 
     bool
     test_mode() const
@@ -108,6 +126,13 @@ namespace knee_contact
     }
 
   private:
+    /** The path of @p name in the staging folder. */
+    std::string
+    staging(const std::string &name) const;
+
+    std::unique_ptr<ResultFolder>                 result_folder;
+    std::vector<std::string>                      warnings;
+    double                                        picture_time_limit = 600;
     std::string                                   output_folder;
     double                                        magnification = 10;
     bool                                          pictures      = true;

@@ -42,7 +42,8 @@ namespace knee_contact
     success             = 0,
     input_error         = 1,
     verification_failed = 2,
-    not_converged       = 3
+    not_converged       = 3,
+    internal_error      = 4
   };
 
 

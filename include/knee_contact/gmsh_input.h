@@ -1,0 +1,58 @@
+#ifndef knee_contact_gmsh_input_h
+#define knee_contact_gmsh_input_h
+
+#include <string>
+#include <vector>
+
+namespace knee_contact
+{
+  /**
+   * Gmsh files from other people, made safe before anything reads them:
+   * deal.II's GridIn trusts its input (a version header that lies about the
+   * body corrupts the heap; an absurd count allocates all memory), and the
+   * gmsh program executes what a .geo asks for. Written by hand because no
+   * library validates a .msh file or a .geo script.
+   */
+  namespace gmsh_input
+  {
+    /**
+     * Split Mesh/Gmsh arguments into words and accept only options that
+     * shape the mesh: -setnumber NAME NUMBER, -clscale, -clmin, -clmax,
+     * -clcurv, -smooth with one number each. Anything else (-string runs
+     * .geo code, -o writes files, ...) is refused with a one-line error.
+     */
+    std::vector<std::string>
+    arguments(const std::string &text);
+
+    /**
+     * Refuse a .geo (and every file it includes) that calls programs or
+     * touches files: SystemCall, NonBlockingSystemCall, OnelabRun, Solver.*
+     * options, Merge, Save, Print, Printf into a file, CreateDir,
+     * DeleteFile, RenameFile, Plugin. The error names the file and line.
+     */
+    void
+    check_geo(const std::string &file);
+
+    /**
+     * Mesh @p geo with gmsh (argument vector, no shell, time limit) into
+     * @p msh (format 2.2); errors name gmsh and the file.
+     */
+    void
+    mesh(const std::string              &geo,
+         const std::string              &msh,
+         const std::vector<std::string> &arguments,
+         const double                    time_limit);
+
+    /**
+     * Check the structure of an ASCII .msh file (version 2.2 or 4.1)
+     * against its header: section order, counts against the file's size,
+     * node tags unique and referenced nodes present, element types deal.II
+     * reads (points, lines, triangles, quadrilaterals), finite coordinates.
+     * The error names the file, the line and what is wrong.
+     */
+    void
+    check_msh(const std::string &file);
+  } // namespace gmsh_input
+} // namespace knee_contact
+
+#endif

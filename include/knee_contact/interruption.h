@@ -1,0 +1,55 @@
+#ifndef knee_contact_interruption_h
+#define knee_contact_interruption_h
+
+#include <string>
+#include <sys/types.h>
+
+namespace knee_contact
+{
+  /**
+   * SIGINT, SIGTERM and SIGHUP stop a run at once, at any point (solve,
+   * output, pictures): the handler kills a running external program (gmsh,
+   * the picture script), removes the run's temporary folders and its lock
+   * file, and exits with 128 + the signal number (130 for Ctrl-C, 143 for
+   * SIGTERM). Everything it does is async-signal-safe (kill, waitpid,
+   * getdents64, unlinkat, rmdir, _exit), so it may interrupt any code,
+   * including a factorisation in another thread; the previous result set in
+   * the output folder is never touched because a run writes only into its
+   * own temporary folder until the final swap.
+   *
+   * Written by hand because no library here offers this; deal.II has no
+   * signal handling.
+   */
+  namespace interruption
+  {
+    /** Install the handlers (once, at the start of main()). */
+    void
+    install();
+
+    /**
+     * Remove @p folder (its files and the folder; one level deep) if a
+     * signal arrives. At most a few folders can be registered.
+     */
+    void
+    register_folder(const std::string &folder);
+
+    void
+    unregister_folder(const std::string &folder);
+
+    /** Remove the file @p file if a signal arrives (the lock file). */
+    void
+    register_file(const std::string &file);
+
+    void
+    unregister_file(const std::string &file);
+
+    /**
+     * The process group of a running external program, killed (SIGKILL) if
+     * a signal arrives; 0 when none runs.
+     */
+    void
+    set_child(pid_t process_group);
+  } // namespace interruption
+} // namespace knee_contact
+
+#endif
