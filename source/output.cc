@@ -25,16 +25,17 @@ namespace knee_contact
     // (ResultFolder), so a failed write only has to be reported.
     void
     write_checked(const std::string                         &file,
+                  const std::string                         &shown,
                   const std::function<void(std::ostream &)> &write)
     {
       std::ofstream out(file);
       AssertThrow(out.good(),
-                  ExcMessage("cannot write '" + file +
+                  ExcMessage("cannot write '" + shown +
                              "': " + std::strerror(errno)));
       write(out);
       out.close();
       AssertThrow(!out.fail(),
-                  ExcMessage("writing '" + file + "' failed: " +
+                  ExcMessage("writing '" + shown + "' failed: " +
                              (errno == ENOSPC ? std::string("no space left "
                                                             "on the device") :
                                                 std::strerror(errno))));
@@ -262,6 +263,7 @@ namespace knee_contact
     data_out.add_data_vector(body_id, "body_id");
     data_out.build_patches();
     write_checked(staging("solution.vtu"),
+ output_folder + "/" + "solution.vtu",
                      [&](std::ostream &out) { data_out.write_vtu(out); });
   }
 
@@ -273,7 +275,7 @@ namespace knee_contact
                             const Vector<double>            &solution,
                             const Results                   &results) const
   {
-    write_checked(staging("cells.csv"), [&](std::ostream &out) {
+    write_checked(staging("cells.csv"), output_folder + "/cells.csv", [&](std::ostream &out) {
       out << "material_id,body_id";
       for (unsigned int v = 0; v < 4; ++v)
         for (const char *name : {"x", "y", "u_x", "u_y", "stress_yy"})
@@ -301,7 +303,8 @@ namespace knee_contact
     const std::string                         &name,
     const std::function<void(std::ostream &)> &write) const
   {
-    write_checked(staging(name), write);
+    write_checked(staging(name),
+ output_folder + "/" + name, write);
   }
 
 
@@ -374,7 +377,9 @@ namespace knee_contact
           [](const char c) { return !std::isalnum(c) && c != '-'; },
           '_');
         write_checked(
-          staging("contact_" + name + ".csv"), [&](std::ostream &out) {
+          staging("contact_" + name + ".csv"),
+          output_folder + "/contact_" + name + ".csv",
+          [&](std::ostream &out) {
             out << "arc_length,x,y,n_x,n_y,gap,jump,pressure,active\n"
                 << std::setprecision(10);
             double s = 0;
@@ -450,7 +455,8 @@ namespace knee_contact
       summary["warnings"] = warnings;
     for (const auto &[phase, seconds] : wall_times)
       summary["wall_time"][phase] = seconds;
-    write_checked(staging("summary.json"), [&](std::ostream &out) {
+    write_checked(staging("summary.json"),
+ output_folder + "/" + "summary.json", [&](std::ostream &out) {
       out << summary.dump(2) << '\n';
     });
   }

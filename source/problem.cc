@@ -2,6 +2,7 @@
 #include <knee_contact/input.h>
 #include <knee_contact/problem.h>
 #include <knee_contact/rigid_modes.h>
+#include <knee_contact/scene_file.h>
 
 #include <deal.II/base/timer.h>
 #include <deal.II/base/utilities.h>
@@ -101,7 +102,20 @@ namespace knee_contact
     : scene_file(scene_file)
     , fe(FE_Q<2>(1), 2)
   {
-    const Counts     counts = read_counts(scene_file);
+    const Counts       counts = read_counts(scene_file);
+    const SceneOutline outline(scene_file);
+    outline.check_numbered("Materials",
+                           "Material",
+                           counts.n_materials,
+                           "Number of materials");
+    outline.check_numbered("Boundary conditions",
+                           "Condition",
+                           counts.n_conditions,
+                           "Number of conditions");
+    outline.check_numbered("Contact",
+                           "Interface",
+                           counts.n_interfaces,
+                           "Number of interfaces");
     ParameterHandler prm;
     declare_parameters(prm, counts);
     parse_scene(prm, scene_file, false);

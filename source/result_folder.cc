@@ -108,6 +108,11 @@ namespace knee_contact
       }
     staging_folder = staging;
     interruption::register_folder(staging_folder);
+    // mkdtemp makes the folder private (0700); a result set is as readable
+    // as any folder the user creates.
+    const mode_t mask = umask(0);
+    umask(mask);
+    chmod(staging_folder.c_str(), 0777 & ~mask);
     std::FILE *const mark = std::fopen((staging + "/" + marker).c_str(), "w");
     if (mark != nullptr)
       std::fclose(mark);

@@ -1,0 +1,2 @@
+// The harm is in an included file.
+Include "delete_file.geo";

@@ -1,0 +1,84 @@
+#!/usr/bin/env bash
+# All-or-nothing results under signals and concurrent runs. Runs SCENE once
+# to make a complete result set, then interrupts runs on the same folder
+# during the solve, during output and during the pictures (SIGINT, SIGTERM,
+# SIGHUP), and requires each time: exit code 128 + signal, one line on
+# stderr, the previous result set unchanged byte for byte, no staging folder
+# or lock file left and no gmsh temporary folder left. Then two runs at once:
+# the second is refused while the first holds the folder, and the first
+# completes. Usage: signals.sh PROGRAM SCENE (a scene with pictures whose
+# solve prints "active set iteration" lines).
+set -u
+export LC_ALL=C
+program=$1
+scene=$2
+work=$(mktemp -d)
+trap 'kill $(jobs -p) 2>/dev/null; rm -rf "$work"' EXIT
+cd "$work"
+# The folder name holds a space, an apostrophe, a $ and a ';': data only.
+folder="out put's \$x;y"
+sed -e "s|^  set Folder .*||" -e "s|= \.\./prm/|= $(dirname "$scene")/../prm/|" \
+  -e 's/^  set Write files .*//' -e 's/^  set Terminal .*//' "$scene" >scene.prm
+printf 'subsection Output\n  set Folder = %s\n  set Pictures = true\nend\n' \
+  "$folder" >>scene.prm
+# Give gmsh a fresh TMPDIR so a leftover temporary folder can be seen.
+export TMPDIR=$work/tmp
+mkdir -p "$TMPDIR"
+fail() { echo "FAIL: $*"; exit 1; }
+
+"$program" scene.prm >first.log 2>&1 || fail "the first run exited non-zero"
+[ -f "$folder/summary.json" ] && [ -f "$folder/deformation.png" ] ||
+  fail "the first run wrote no complete result set"
+(cd "$folder" && md5sum -- * | sort) >before.md5
+
+wait_for() { # wait_for SECONDS COMMAND...: poll until COMMAND succeeds
+  local limit=$1
+  shift
+  for _ in $(seq 1 $((limit * 100))); do
+    "$@" && return 0
+    sleep 0.01
+  done
+  return 1
+}
+in_solve() { grep -q "active set iteration" run.log; }
+staged() { compgen -G ".out put's \$x;y.new-*/$1" >/dev/null; }
+writing_output() { staged solution.vtu; }
+drawing() { staged pictures.log; }
+
+n=0
+for phase in in_solve writing_output drawing; do
+  for signal in INT TERM HUP; do
+    "$program" scene.prm >run.log 2>run.err &
+    pid=$!
+    wait_for 60 $phase || fail "$phase: never reached"
+    kill -$signal $pid
+    wait $pid
+    code=$?
+    expected=$((128 + $(kill -l $signal)))
+    [ $code -eq $expected ] || fail "$phase, SIG$signal: exit code $code, expected $expected"
+    [ "$(wc -l <run.err)" -eq 1 ] || fail "$phase, SIG$signal: stderr is not one line"
+    (cd "$folder" && md5sum -- * | sort) | cmp -s - before.md5 ||
+      fail "$phase, SIG$signal: the previous result set changed"
+    [ -z "$(ls -A "$TMPDIR")" ] || fail "$phase, SIG$signal: temporary files left in TMPDIR"
+    [ "$(ls -A | grep -c "^\.out")" -eq 0 ] ||
+      fail "$phase, SIG$signal: staging folder or lock left: $(ls -A)"
+    n=$((n + 1))
+    echo "PASS: SIG$signal $phase: exit $code, result set unchanged, nothing left"
+  done
+done
+
+# Two runs on one folder: the second is refused with one line while the
+# first lives, and the first still completes.
+"$program" scene.prm >run.log 2>run.err &
+pid=$!
+wait_for 60 in_solve || fail "concurrent: the first run never reached the solve"
+"$program" scene.prm >second.log 2>second.err
+code=$?
+[ $code -eq 1 ] || fail "concurrent: the second run exited $code, expected 1"
+grep -q "another knee_contact run is writing" second.err ||
+  fail "concurrent: unexpected message: $(cat second.err)"
+wait $pid || fail "concurrent: the first run failed"
+[ -f "$folder/summary.json" ] && [ -f "$folder/deformation.png" ] ||
+  fail "concurrent: no complete result set after the first run"
+echo "PASS: a second run on the same folder is refused; the first completes"
+echo "PASS: $n interruptions"
