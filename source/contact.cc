@@ -1,4 +1,5 @@
 #include <knee_contact/contact.h>
+#include <knee_contact/input.h>
 
 #include <deal.II/lac/vector.h>
 
@@ -10,6 +11,22 @@
 
 namespace knee_contact
 {
+  std::string
+  csv_file_name(const std::string &interface_name)
+  {
+    std::string name = interface_name;
+    std::replace_if(
+      name.begin(),
+      name.end(),
+      [](const char c) {
+        return !std::isalnum(static_cast<unsigned char>(c)) && c != '-';
+      },
+      '_');
+    return "contact_" + name + ".csv";
+  }
+
+
+
   double
   ContactPair::jump(const Vector<double> &x) const
   {
@@ -77,6 +94,8 @@ namespace knee_contact
         prm.enter_subsection("Interface " + std::to_string(i));
         ContactInterface interface;
         interface.name = prm.get("Name");
+        input::check_name(interface.name,
+                          "Contact/Interface " + std::to_string(i) + "/Name");
         interface.slave_id =
           static_cast<types::boundary_id>(prm.get_integer("Slave boundary id"));
         interface.master_id = static_cast<types::boundary_id>(
@@ -90,6 +109,15 @@ namespace knee_contact
                                "slave and master boundary ids are "
                                "both " +
                                std::to_string(interface.slave_id)));
+        for (const auto &other : list)
+          AssertThrow(other.name != interface.name &&
+                        csv_file_name(other.name) !=
+                          csv_file_name(interface.name),
+                      ExcMessage(where + "the name '" + interface.name +
+                                 "' is (as a file name, " +
+                                 csv_file_name(interface.name) +
+                                 ") that of interface '" + other.name +
+                                 "' too"));
         for (const auto &other : list)
           AssertThrow(other.slave_id != interface.slave_id &&
                         other.slave_id != interface.master_id &&

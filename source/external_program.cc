@@ -1,14 +1,15 @@
 #include <knee_contact/external_program.h>
 #include <knee_contact/interruption.h>
 
-#include <chrono>
-#include <csignal>
 #include <fcntl.h>
-#include <fstream>
 #include <spawn.h>
 #include <sys/wait.h>
-#include <thread>
 #include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <fstream>
+#include <thread>
 
 extern char **environ;
 
@@ -27,11 +28,8 @@ namespace knee_contact
     posix_spawn_file_actions_init(&actions);
     posix_spawn_file_actions_addopen(
       &actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_addopen(&actions,
-                                     STDOUT_FILENO,
-                                     log.c_str(),
-                                     O_WRONLY | O_CREAT | O_TRUNC,
-                                     0644);
+    posix_spawn_file_actions_addopen(
+      &actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
 
     // Its own process group (so the time limit and an interruption kill
@@ -66,8 +64,8 @@ namespace knee_contact
     const bool search = arguments[0].find('/') == std::string::npos;
     const int  status =
       search ? posix_spawnp(
-                 &pid, argv[0], &actions, &attributes, argv.data(), environ) :
-                posix_spawn(
+                 &pid, argv[0], &actions, &attributes, argv.data(), environ)
+              : posix_spawn(
                  &pid, argv[0], &actions, &attributes, argv.data(), environ);
     if (status == 0)
       interruption::set_child(pid);

@@ -71,18 +71,18 @@ namespace knee_contact
         }
 
         std::vector<std::string>
-        expect(const std::size_t n_min,
-               const std::size_t n_max,
+        expect(const std::size_t  n_min,
+               const std::size_t  n_max,
                const std::string &what)
         {
           std::vector<std::string> tokens;
           if (!next(tokens))
             fail("the file ends before " + what + " (truncated?)");
           if (tokens.size() < n_min || tokens.size() > n_max)
-            fail("expected " + what + ", found " +
-                 std::to_string(tokens.size()) + " fields" +
-                 (n_min == n_max ? " instead of " + std::to_string(n_min) :
-                                   ""));
+            fail(
+              "expected " + what + ", found " + std::to_string(tokens.size()) +
+              " fields" +
+              (n_min == n_max ? " instead of " + std::to_string(n_min) : ""));
           return tokens;
         }
 
@@ -260,8 +260,9 @@ namespace knee_contact
                       {
                         // point: tag x y z n_phys tags...; curves and
                         // surfaces: tag box(6) n_phys tags... n_b tags...
-                        const auto e = reader.expect(
-                          dim == 0 ? 5 : 9, 1u << 20, "an entity");
+                        const auto e = reader.expect(dim == 0 ? 5 : 9,
+                                                     1u << 20,
+                                                     "an entity");
                         const std::size_t p = dim == 0 ? 4 : 7;
                         const auto        n_phys =
                           reader.count(e[p], "physical tag count");
@@ -279,19 +280,19 @@ namespace knee_contact
             else if (t[0] == "$Nodes")
               {
                 t = reader.expect(4, 4, "'numEntityBlocks numNodes ...'");
-                const auto n_blocks = reader.count(t[0], "block count");
-                const auto n_total  = reader.count(t[1], "node count");
-                unsigned long long n_read = 0;
+                const auto         n_blocks = reader.count(t[0], "block count");
+                const auto         n_total  = reader.count(t[1], "node count");
+                unsigned long long n_read   = 0;
                 for (unsigned long long b = 0; b < n_blocks; ++b)
                   {
-                    t = reader.expect(4, 4, "a node block header");
+                    t            = reader.expect(4, 4, "a node block header");
                     const auto n = reader.count(t[3], "node count of a block");
                     const bool parametric = t[2] != "0";
                     for (unsigned long long i = 0; i < n; ++i)
                       if (!nodes
-                             .insert(reader.tag(
-                               reader.expect(1, 1, "a node tag")[0],
-                               "node tag"))
+                             .insert(
+                               reader.tag(reader.expect(1, 1, "a node tag")[0],
+                                          "node tag"))
                              .second)
                         reader.fail("a node tag appears twice");
                     for (unsigned long long i = 0; i < n; ++i)
@@ -337,9 +338,8 @@ namespace knee_contact
                                           "an element 'tag nodes...'");
                         for (std::size_t k = 1; k < t.size(); ++k)
                           if (nodes.count(reader.tag(t[k], "node tag")) == 0)
-                            reader.fail("element " + t[0] +
-                                        " refers to node " + t[k] +
-                                        ", which is not in $Nodes");
+                            reader.fail("element " + t[0] + " refers to node " +
+                                        t[k] + ", which is not in $Nodes");
                       }
                   }
                 reader.end_of("Elements");
@@ -421,17 +421,25 @@ namespace knee_contact
               for (; i < text.size() && text[i] != '\n'; ++i)
                 text[i] = ' ';
             else if (text[i] == '/' && text[i + 1] == '*')
-              for (; i < text.size() &&
-                     !(text[i] == '*' && i + 1 < text.size() &&
-                       text[i + 1] == '/');
+              for (;
+                   i < text.size() && !(text[i] == '*' && i + 1 < text.size() &&
+                                        text[i + 1] == '/');
                    ++i)
                 if (text[i] != '\n')
                   text[i] = ' ';
           static const std::set<std::string> forbidden = {
-            "SystemCall", "NonBlockingSystemCall", "OnelabRun",
-            "Merge",      "MergeWithBoundingBox",  "Save",
-            "Print",      "CreateDir",             "DeleteFile",
-            "RenameFile", "Plugin",                "Shell"};
+            "SystemCall",
+            "NonBlockingSystemCall",
+            "OnelabRun",
+            "Merge",
+            "MergeWithBoundingBox",
+            "Save",
+            "Print",
+            "CreateDir",
+            "DeleteFile",
+            "RenameFile",
+            "Plugin",
+            "Shell"};
           unsigned int line = 1;
           for (std::size_t i = 0; i < text.size();)
             {
@@ -456,10 +464,9 @@ namespace knee_contact
               const std::size_t end  = text.find(';', j);
               const std::string statement =
                 text.substr(j, end == std::string::npos ? end : end - j);
-              const auto where = "Mesh/File: '" + name + "' line " +
-                                 std::to_string(line) + ": ";
-              if (forbidden.count(word) != 0 ||
-                  word.rfind("Solver.", 0) == 0 ||
+              const auto where =
+                "Mesh/File: '" + name + "' line " + std::to_string(line) + ": ";
+              if (forbidden.count(word) != 0 || word.rfind("Solver.", 0) == 0 ||
                   (word == "Printf" &&
                    statement.find('>') != std::string::npos))
                 throw std::runtime_error(
@@ -475,10 +482,11 @@ namespace knee_contact
                                              "Include without a file name");
                   const std::filesystem::path included =
                     statement.substr(open + 1, close - open - 1);
-                  check(included.is_absolute() ?
-                          included.string() :
-                          (std::filesystem::path(name).parent_path() / included)
-                            .string(),
+                  check(included.is_absolute()
+                          ? included.string()
+                          : (std::filesystem::path(name).parent_path() /
+                             included)
+                              .string(),
                         depth + 1);
                 }
               i = j;

@@ -2,6 +2,8 @@
 
 #include <deal.II/lac/vector.h>
 
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -201,7 +203,66 @@ namespace knee_contact
       // Strip a line of dashes deal.II adds around its messages.
       while (!line.empty() && line.back() == '-')
         line.pop_back();
-      return Utilities::trim(line);
+      return cap(Utilities::trim(line));
+    }
+
+
+
+    std::string
+    cap(const std::string &line)
+    {
+      // A value echoed in quotes ('...' or ParameterHandler's <...>) keeps
+      // its first 200 bytes, cut at a character boundary.
+      const auto cut = [](const std::string &text, std::size_t n) {
+        while (n > 0 && n < text.size() &&
+               (static_cast<unsigned char>(text[n]) & 0xC0) == 0x80)
+          --n;
+        return text.substr(0, n);
+      };
+      std::string result;
+      for (std::size_t i = 0; i < line.size();)
+        {
+          const char open  = line[i];
+          const char close = open == '\'' ? '\'' : (open == '<' ? '>' : '\0');
+          const std::size_t end =
+            close ? line.find(close, i + 1) : std::string::npos;
+          if (end != std::string::npos && end - i - 1 > 200)
+            {
+              const std::string value = line.substr(i + 1, end - i - 1);
+              result += open + cut(value, 200) + "... (" +
+                        std::to_string(value.size()) + " characters)" + close;
+              i = end + 1;
+            }
+          else
+            result += line[i++];
+        }
+      return result.size() > 1000 ? cut(result, 1000) + "..." : result;
+    }
+
+
+
+    void
+    check_name(const std::string &name, const std::string &parameter)
+    {
+      AssertThrow(!name.empty() && name.size() <= 100,
+                  ExcMessage(parameter + ": a name needs 1 to 100 bytes"));
+      for (std::size_t i = 0; i < name.size(); ++i)
+        AssertThrow(static_cast<unsigned char>(name[i]) >= 32 && name[i] != 127,
+                    ExcMessage(parameter + ": '" + one_line(name) +
+                               "' holds a control character (byte " +
+                               std::to_string(i + 1) + ")"));
+      // summary.json must stay valid JSON: nlohmann-json's encoder checks
+      // UTF-8 strictly (overlong forms and surrogates too).
+      try
+        {
+          (void)nlohmann::json(name).dump();
+        }
+      catch (const nlohmann::json::exception &)
+        {
+          AssertThrow(false,
+                      ExcMessage(parameter + ": '" + one_line(name) +
+                                 "' is not valid UTF-8 text"));
+        }
     }
   } // namespace input
 } // namespace knee_contact

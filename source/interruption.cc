@@ -1,13 +1,14 @@
 #include <knee_contact/interruption.h>
 
-#include <atomic>
-#include <csignal>
-#include <cstring>
 #include <dirent.h>
 #include <fcntl.h>
 #include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include <atomic>
+#include <csignal>
+#include <cstring>
 
 namespace knee_contact
 {

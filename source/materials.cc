@@ -1,7 +1,9 @@
 #include <knee_contact/input.h>
 #include <knee_contact/materials.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace knee_contact
 {
@@ -104,8 +106,14 @@ namespace knee_contact
                     ExcMessage("Materials/" + section + ": material id " +
                                std::to_string(id) +
                                " is given to more than one material"));
-        Material &material      = materials[id];
-        material.name           = prm.get("Name");
+        Material &material = materials[id];
+        material.name      = prm.get("Name");
+        input::check_name(material.name, "Materials/" + section + "/Name");
+        for (const auto &[other_id, other] : materials)
+          AssertThrow(other_id == id || other.name != material.name,
+                      ExcMessage("Materials/" + section + "/Name: '" +
+                                 material.name +
+                                 "' is the name of another material too"));
         material.youngs_modulus = prm.get_double("Young's modulus");
         material.poissons_ratio = prm.get_double("Poisson's ratio");
         material.plane_strain   = plane_strain;
@@ -117,6 +125,14 @@ namespace knee_contact
                     ExcMessage("Materials/" + section +
                                "/Young's modulus: E must be > 0, got " +
                                prm.get("Young's modulus")));
+        // Beyond these the stiffness or the displacement leaves the range
+        // of double precision (E = 1e-300 gives an infinite energy).
+        AssertThrow(E >= 1e-20 && E <= 1e30,
+                    ExcMessage(
+                      "Materials/" + section +
+                      "/Young's modulus: E = " + prm.get("Young's modulus") +
+                      " is outside [1e-20, 1e30] (choose units "
+                      "that keep E and the loads near 1)"));
         AssertThrow(std::isfinite(nu) && nu > -1 && nu < 0.5,
                     ExcMessage("Materials/" + section +
                                "/Poisson's ratio: nu must lie in (-1, 0.5), "
@@ -134,6 +150,21 @@ namespace knee_contact
         prm.leave_subsection();
       }
     prm.leave_subsection();
+
+    // A contrast beyond 1e12 leaves fewer than 4 correct digits in the
+    // soft body (round-off grows with the condition number).
+    double E_min = std::numeric_limits<double>::max(), E_max = 0;
+    for (const auto &[id, material] : materials)
+      {
+        E_min = std::min(E_min, material.youngs_modulus);
+        E_max = std::max(E_max, material.youngs_modulus);
+      }
+    AssertThrow(E_max <= 1e12 * E_min,
+                ExcMessage("Materials: the contrast of Young's moduli " +
+                           std::to_string(E_max / E_min) +
+                           " exceeds 1e12; the soft body's displacements "
+                           "would have no correct digits (model the stiff "
+                           "body as rigid with a displacement condition)"));
   }
 
 
@@ -157,6 +188,17 @@ namespace knee_contact
     const auto it = materials.find(id);
     Assert(it != materials.end(), ExcInternalError());
     return it->second;
+  }
+
+
+
+  double
+  Materials::min_youngs_modulus() const
+  {
+    double E = std::numeric_limits<double>::max();
+    for (const auto &m : materials)
+      E = std::min(E, m.second.youngs_modulus);
+    return E;
   }
 
 

@@ -155,25 +155,7 @@ namespace knee_contact
 
     AssertThrow(triangulation.n_active_cells() > 0,
                 ExcMessage("Mesh: the mesh has no cells"));
-    // The Jacobian of a bilinear quadrilateral is positive everywhere iff
-    // the cross products of the edges at all four corners are (deal.II's
-    // vertex order 0 1 3 2 runs counter-clockwise).
-    for (const auto &cell : triangulation.active_cell_iterators())
-      {
-        const unsigned int ring[4] = {0, 1, 3, 2};
-        for (unsigned int k = 0; k < 4; ++k)
-          {
-            const Tensor<1, 2> a =
-              cell->vertex(ring[(k + 1) % 4]) - cell->vertex(ring[k]);
-            const Tensor<1, 2> b =
-              cell->vertex(ring[(k + 3) % 4]) - cell->vertex(ring[k]);
-            AssertThrow(a[0] * b[1] - a[1] * b[0] > 1e-12 * a.norm() * b.norm(),
-                        ExcMessage("Mesh: cell at (" +
-                                   std::to_string(cell->center()[0]) + ", " +
-                                   std::to_string(cell->center()[1]) +
-                                   ") is inverted, degenerate or not convex"));
-          }
-      }
+    check_cells(triangulation);
 
     if (rotation_degrees != 0)
       GridTools::rotate(rotation_degrees * numbers::PI / 180, triangulation);
@@ -192,6 +174,23 @@ namespace knee_contact
         for (const auto &face : triangulation.active_face_iterators())
           if (face->at_boundary() && face->boundary_id() == id)
             {
+              // PolarManifold puts new vertices at the radius of the
+              // face's ends: both must lie on one circle about the centre.
+              const double r0 = face->vertex(0).distance(c),
+                           r1 = face->vertex(1).distance(c);
+              AssertThrow(
+                r0 > 0 && std::abs(r0 - r1) <= 1e-6 * std::max(r0, r1) &&
+                  face->vertex(0).distance(face->vertex(1)) < std::max(r0, r1),
+                ExcMessage("Mesh/Circular boundaries: the edge of boundary "
+                           "id " +
+                           std::to_string(id) + " from (" +
+                           std::to_string(face->vertex(0)[0]) + ", " +
+                           std::to_string(face->vertex(0)[1]) + ") to (" +
+                           std::to_string(face->vertex(1)[0]) + ", " +
+                           std::to_string(face->vertex(1)[1]) +
+                           ") is not an arc about the given centre (radii " +
+                           std::to_string(r0) + " and " + std::to_string(r1) +
+                           ")"));
               face->set_manifold_id(manifold);
               found = true;
             }
@@ -232,6 +231,40 @@ namespace knee_contact
                   std::to_string(available / 1e9).substr(0, 5) +
                   " GB available"));
     triangulation.refine_global(n_refinements);
+    if (n_refinements > 0)
+      check_cells(triangulation);
+  }
+
+
+
+  void
+  check_cells(const Triangulation<2> &triangulation)
+  {
+    // The Jacobian of a bilinear quadrilateral is positive everywhere iff
+    // the cross products of the edges at all four corners are (deal.II's
+    // vertex order 0 1 3 2 runs counter-clockwise). Checked on every mesh
+    // the program solves on: refinement on a circle that does not fit the
+    // vertices can fold cells.
+    for (const auto &cell : triangulation.active_cell_iterators())
+      {
+        const unsigned int ring[4] = {0, 1, 3, 2};
+        for (unsigned int k = 0; k < 4; ++k)
+          {
+            const Tensor<1, 2> a =
+              cell->vertex(ring[(k + 1) % 4]) - cell->vertex(ring[k]);
+            const Tensor<1, 2> b =
+              cell->vertex(ring[(k + 3) % 4]) - cell->vertex(ring[k]);
+            AssertThrow(a[0] * b[1] - a[1] * b[0] > 1e-12 * a.norm() * b.norm(),
+                        ExcMessage("Mesh: cell at (" +
+                                   std::to_string(cell->center()[0]) + ", " +
+                                   std::to_string(cell->center()[1]) +
+                                   ") is inverted, degenerate or not convex" +
+                                   (cell->level() > 0
+                                      ? " after refinement (level " +
+                                          std::to_string(cell->level()) + ")"
+                                      : std::string())));
+          }
+      }
   }
 
 

@@ -8,8 +8,8 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
-#include <cmath>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -37,8 +37,8 @@ namespace knee_contact
       AssertThrow(!out.fail(),
                   ExcMessage("writing '" + shown + "' failed: " +
                              (errno == ENOSPC ? std::string("no space left "
-                                                            "on the device") :
-                                                std::strerror(errno))));
+                                                            "on the device")
+                                              : std::strerror(errno))));
     }
 
 
@@ -166,10 +166,10 @@ namespace knee_contact
     if (output_folder.empty())
       output_folder =
         "output/" + std::filesystem::path(scene_file).stem().string();
-    magnification = prm.get_double("Deformation magnification");
-    terminal_test = prm.get("Terminal") == "test";
-    write_files   = prm.get_bool("Write files");
-    pictures      = prm.get_bool("Pictures");
+    magnification      = prm.get_double("Deformation magnification");
+    terminal_test      = prm.get("Terminal") == "test";
+    write_files        = prm.get_bool("Write files");
+    pictures           = prm.get_bool("Pictures");
     picture_time_limit = prm.get_double("Picture time limit");
     for (const auto &[name, point] :
          input::split_named(prm.get("Labels"), "Output/Labels", "name: x, y"))
@@ -263,8 +263,8 @@ namespace knee_contact
     data_out.add_data_vector(body_id, "body_id");
     data_out.build_patches();
     write_checked(staging("solution.vtu"),
- output_folder + "/" + "solution.vtu",
-                     [&](std::ostream &out) { data_out.write_vtu(out); });
+                  output_folder + "/" + "solution.vtu",
+                  [&](std::ostream &out) { data_out.write_vtu(out); });
   }
 
 
@@ -275,25 +275,28 @@ namespace knee_contact
                             const Vector<double>            &solution,
                             const Results                   &results) const
   {
-    write_checked(staging("cells.csv"), output_folder + "/cells.csv", [&](std::ostream &out) {
-      out << "material_id,body_id";
-      for (unsigned int v = 0; v < 4; ++v)
-        for (const char *name : {"x", "y", "u_x", "u_y", "stress_yy"})
-          out << ',' << name << v;
-      out << '\n' << std::setprecision(9);
-      for (const auto &cell : dof_handler.active_cell_iterators())
-        {
-          out << static_cast<unsigned int>(cell->material_id()) << ','
-              << body_of_cell[cell->active_cell_index()];
-          // Counter-clockwise: deal.II's vertex order is 0 1 3 2.
-          for (const unsigned int v : {0u, 1u, 3u, 2u})
-            out << ',' << cell->vertex(v)[0] << ',' << cell->vertex(v)[1] << ','
-                << solution(cell->vertex_dof_index(v, 0)) << ','
-                << solution(cell->vertex_dof_index(v, 1)) << ','
-                << results.vertex_stress_yy[cell->active_cell_index()][v];
-          out << '\n';
-        }
-    });
+    write_checked(
+      staging("cells.csv"),
+      output_folder + "/cells.csv",
+      [&](std::ostream &out) {
+        out << "material_id,body_id";
+        for (unsigned int v = 0; v < 4; ++v)
+          for (const char *name : {"x", "y", "u_x", "u_y", "stress_yy"})
+            out << ',' << name << v;
+        out << '\n' << std::setprecision(9);
+        for (const auto &cell : dof_handler.active_cell_iterators())
+          {
+            out << static_cast<unsigned int>(cell->material_id()) << ','
+                << body_of_cell[cell->active_cell_index()];
+            // Counter-clockwise: deal.II's vertex order is 0 1 3 2.
+            for (const unsigned int v : {0u, 1u, 3u, 2u})
+              out << ',' << cell->vertex(v)[0] << ',' << cell->vertex(v)[1]
+                  << ',' << solution(cell->vertex_dof_index(v, 0)) << ','
+                  << solution(cell->vertex_dof_index(v, 1)) << ','
+                  << results.vertex_stress_yy[cell->active_cell_index()][v];
+            out << '\n';
+          }
+      });
   }
 
 
@@ -303,8 +306,7 @@ namespace knee_contact
     const std::string                         &name,
     const std::function<void(std::ostream &)> &write) const
   {
-    write_checked(staging(name),
- output_folder + "/" + name, write);
+    write_checked(staging(name), output_folder + "/" + name, write);
   }
 
 
@@ -370,16 +372,9 @@ namespace knee_contact
         std::sort(order.begin(), order.end(), [&](unsigned a, unsigned b) {
           return pairs[a].position[axis] < pairs[b].position[axis];
         });
-        std::string name = interfaces.interfaces()[i].name;
-        std::replace_if(
-          name.begin(),
-          name.end(),
-          [](const char c) { return !std::isalnum(c) && c != '-'; },
-          '_');
+        const std::string name = csv_file_name(interfaces.interfaces()[i].name);
         write_checked(
-          staging("contact_" + name + ".csv"),
-          output_folder + "/contact_" + name + ".csv",
-          [&](std::ostream &out) {
+          staging(name), output_folder + "/" + name, [&](std::ostream &out) {
             out << "arc_length,x,y,n_x,n_y,gap,jump,pressure,active\n"
                 << std::setprecision(10);
             double s = 0;
@@ -456,8 +451,7 @@ namespace knee_contact
     for (const auto &[phase, seconds] : wall_times)
       summary["wall_time"][phase] = seconds;
     write_checked(staging("summary.json"),
- output_folder + "/" + "summary.json", [&](std::ostream &out) {
-      out << summary.dump(2) << '\n';
-    });
+                  output_folder + "/" + "summary.json",
+                  [&](std::ostream &out) { out << summary.dump(2) << '\n'; });
   }
 } // namespace knee_contact

@@ -2,6 +2,7 @@
 #include <knee_contact/input.h>
 #include <knee_contact/problem.h>
 #include <knee_contact/rigid_modes.h>
+#include <knee_contact/scene_checks.h>
 #include <knee_contact/scene_file.h>
 
 #include <deal.II/base/timer.h>
@@ -13,12 +14,14 @@
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/fe/fe_q.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <new>
 #include <set>
 
 namespace knee_contact
@@ -128,6 +131,7 @@ namespace knee_contact
     output_writer.parse_parameters(prm, scene_file);
     verification.parse_parameters(prm);
     refinement.parse_parameters(prm);
+    scene_checks::check_roles(boundary_conditions, contact_interfaces);
   }
 
 
@@ -152,6 +156,7 @@ namespace knee_contact
     materials.check_mesh(triangulation);
     boundary_conditions.check_mesh(triangulation);
     body_of_cell = compute_body_ids(triangulation, n_bodies);
+    scene_checks::check_joints(triangulation, body_of_cell);
     contact_interfaces.check_mesh(triangulation, body_of_cell);
   }
 
@@ -224,14 +229,20 @@ namespace knee_contact
           if (cycle == 0)
             make_mesh();
           else
-            refinement.refine(strategy,
-                              triangulation,
-                              dof_handler,
-                              displacement,
-                              materials,
-                              contact_interfaces,
-                              contact_pairs,
-                              contact_solution);
+            {
+              refinement.refine(strategy,
+                                triangulation,
+                                dof_handler,
+                                displacement,
+                                materials,
+                                contact_interfaces,
+                                contact_pairs,
+                                contact_solution);
+              check_cells(triangulation);
+            }
+          scene_checks::check_finite_data(triangulation,
+                                          materials,
+                                          boundary_conditions);
         });
         timed("setup", [&]() { setup_system(); });
         std::cout << record.strategy << " cycle " << cycle << ": "
@@ -266,13 +277,32 @@ namespace knee_contact
                                         contact_pairs.empty() ? quiet
                                                               : std::cout);
             }
-          catch (const SparseDirectUMFPACK::ExcUMFPACKError &)
+          catch (const SparseDirectUMFPACK::ExcUMFPACKError &exc)
             {
+              // UMFPACK's status: 1 singular, -1 out of memory.
+              std::ostringstream info;
+              exc.print_info(info);
+              const bool memory =
+                info.str().find("status -1") != std::string::npos;
+              if (memory)
+                throw std::bad_alloc();
               AssertThrow(false,
                           ExcMessage("UMFPACK: the stiffness matrix is "
                                      "singular; check that every body is "
                                      "held"));
             }
+          // Finite data and moduli were checked; a non-finite solution
+          // means they are too extreme together for double precision.
+          for (const double u : displacement)
+            AssertThrow(std::isfinite(u),
+                        ExcMessage(
+                          "the solution is not finite: the loads and "
+                          "displacements are too large for the moduli "
+                          "(E from " +
+                          std::to_string(materials.min_youngs_modulus()) +
+                          " to " +
+                          std::to_string(materials.max_youngs_modulus()) +
+                          " Pa); choose units that keep them near 1"));
         });
         timed("postprocess", [&]() {
           results       = compute_results(dof_handler,
@@ -373,11 +403,11 @@ namespace knee_contact
       {
         // The pictures read summary.json; a picture failure is kept in it
         // as a warning.
-        output_writer.write_summary(
-          results,
-          contact_solution,
-          materials,
-          timer.get_summary_data(TimerOutput::total_wall_time));
+        output_writer.write_summary(results,
+                                    contact_solution,
+                                    materials,
+                                    timer.get_summary_data(
+                                      TimerOutput::total_wall_time));
         TimerOutput::Scope scope(timer, "pictures");
         std::string        message;
         if (!output_writer.run_script("plot_results.py", message) ||
@@ -385,11 +415,11 @@ namespace knee_contact
              !output_writer.run_script("plot_study.py", message)))
           {
             output_writer.warn("no pictures: " + message);
-            output_writer.write_summary(
-              results,
-              contact_solution,
-              materials,
-              timer.get_summary_data(TimerOutput::total_wall_time));
+            output_writer.write_summary(results,
+                                        contact_solution,
+                                        materials,
+                                        timer.get_summary_data(
+                                          TimerOutput::total_wall_time));
           }
       }
     const auto wall_times =

@@ -67,6 +67,8 @@ namespace knee_contact
                           : s == "adaptive" ? Strategy::adaptive
                                             : Strategy::compare;
     refine_fraction     = prm.get_double("Refine fraction");
+    indicator           = prm.get("Indicator") == "kelly" ? Indicator::kelly
+                                                          : Indicator::kelly_contact;
     prm.leave_subsection();
   }
 
@@ -87,17 +89,17 @@ namespace knee_contact
         triangulation.refine_global(1);
         return;
       }
-    Vector<float> indicator(triangulation.n_active_cells());
+    Vector<float> kelly(triangulation.n_active_cells());
     KellyErrorEstimator<2>::estimate(
-      dof_handler, QGauss<1>(2), {}, solution, indicator);
+      dof_handler, QGauss<1>(2), {}, solution, kelly);
     for (const auto &cell : triangulation.active_cell_iterators())
-      indicator(cell->active_cell_index()) *=
+      kelly(cell->active_cell_index()) *=
         std::sqrt(materials[cell->material_id()].youngs_modulus);
     GridRefinement::refine_and_coarsen_fixed_fraction(triangulation,
-                                                      indicator,
+                                                      kelly,
                                                       refine_fraction,
                                                       0.);
-    if (contact_indicator)
+    if (indicator == Indicator::kelly_contact)
       {
         // The contact zone: within one slave spacing of an active pair, on
         // either side.

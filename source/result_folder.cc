@@ -1,16 +1,17 @@
 #include <knee_contact/interruption.h>
 #include <knee_contact/result_folder.h>
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fcntl.h>
 #include <filesystem>
 #include <stdexcept>
-#include <sys/file.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 namespace knee_contact
 {
@@ -57,8 +58,7 @@ namespace knee_contact
     std::error_code code;
     fs::create_directories(parent, code);
     if (code)
-      throw error("cannot create '" + parent.string() +
-                  "': " + code.message());
+      throw error("cannot create '" + parent.string() + "': " + code.message());
     if (fs::exists(path, code) && !fs::is_directory(path, code))
       throw error("'" + folder + "' exists and is not a folder");
     if (fs::is_directory(path, code) && !is_result_set(path))

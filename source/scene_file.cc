@@ -51,7 +51,7 @@ namespace knee_contact
         std::vector<std::set<std::string>> keys(1);
         std::vector<bool>                  named;
         std::string                        pending_key;
-        const auto callback = [&](int                              depth,
+        const auto                         callback = [&](int                              depth,
                                   nlohmann::json::parse_event_t    event,
                                   [[maybe_unused]] nlohmann::json &value) {
           using event_t = nlohmann::json::parse_event_t;
@@ -165,7 +165,8 @@ namespace knee_contact
           std::to_string(k) + "' (it would silently take the defaults)");
     const std::string start = section + "/" + prefix + " ";
     for (const auto &s : subsections)
-      if (s.rfind(start, 0) == 0 && s.find('/', start.size()) == std::string::npos)
+      if (s.rfind(start, 0) == 0 &&
+          s.find('/', start.size()) == std::string::npos)
         {
           const std::string index = s.substr(start.size());
           if (index.find_first_not_of("0123456789") != std::string::npos ||

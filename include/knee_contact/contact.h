@@ -60,6 +60,15 @@ namespace knee_contact
 
 
 
+  /**
+   * The contact CSV of an interface: contact_<name>.csv with every
+   * character but letters, digits and '-' replaced by '_'.
+   */
+  std::string
+  csv_file_name(const std::string &interface_name);
+
+
+
   struct ContactInterface
   {
     std::string        name;

@@ -81,6 +81,21 @@ namespace knee_contact
      */
     std::string
     one_line(const std::string &text);
+
+    /**
+     * Shorten values echoed in a message ('...' or <...>) to 200 bytes and
+     * the whole message to 1000: a 6 MB expression is not a message.
+     */
+    std::string
+    cap(const std::string &line);
+
+    /**
+     * A name of a material or interface: 1 to 100 bytes of valid UTF-8
+     * without control characters (it goes into summary.json and file
+     * names), or an error naming @p parameter.
+     */
+    void
+    check_name(const std::string &name, const std::string &parameter);
   } // namespace input
 } // namespace knee_contact
 

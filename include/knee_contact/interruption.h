@@ -1,8 +1,9 @@
 #ifndef knee_contact_interruption_h
 #define knee_contact_interruption_h
 
-#include <string>
 #include <sys/types.h>
+
+#include <string>
 
 namespace knee_contact
 {

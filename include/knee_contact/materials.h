@@ -86,6 +86,9 @@ namespace knee_contact
     double
     max_youngs_modulus() const;
 
+    double
+    min_youngs_modulus() const;
+
   private:
     std::map<types::material_id, Material> materials;
   };

@@ -80,6 +80,12 @@ namespace knee_contact
   std::vector<unsigned int>
   compute_body_ids(const Triangulation<2> &triangulation,
                    unsigned int           &n_bodies);
+  /**
+   * Refuse a mesh with an inverted, degenerate or non-convex cell, with the
+   * cell's place (on the coarse mesh and after every refinement).
+   */
+  void
+  check_cells(const Triangulation<2> &triangulation);
 } // namespace knee_contact
 
 #endif

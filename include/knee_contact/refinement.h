@@ -76,8 +76,14 @@ namespace knee_contact
     mark_partners(Triangulation<2>        &triangulation,
                   const ContactInterfaces &interfaces) const;
 
-    double refine_fraction   = 0.5;
-    bool   contact_indicator = true;
+    double refine_fraction = 0.5;
+    /** Refinement/Indicator. */
+    enum class Indicator
+    {
+      kelly,
+      kelly_contact
+    };
+    Indicator indicator = Indicator::kelly_contact;
   };
 } // namespace knee_contact
 
