@@ -136,42 +136,6 @@ namespace knee_contact
     check_joints(const Triangulation<2>          &triangulation,
                  const std::vector<unsigned int> &body_of_cell)
     {
-      // Around each vertex, the cells that share it must be connected
-      // through faces that contain it (Triangulation's vertex_to_cell_map).
-      const auto cells_at = GridTools::vertex_to_cell_map(triangulation);
-      for (unsigned int v = 0; v < cells_at.size(); ++v)
-        {
-          if (cells_at[v].size() < 2)
-            continue;
-          std::vector<Triangulation<2>::active_cell_iterator> around(
-            cells_at[v].begin(), cells_at[v].end());
-          std::vector<unsigned int> parent(around.size());
-          std::iota(parent.begin(), parent.end(), 0);
-          const auto find = [&](unsigned int i) {
-            while (parent[i] != i)
-              i = parent[i];
-            return i;
-          };
-          for (unsigned int i = 0; i < around.size(); ++i)
-            for (const auto f : around[i]->face_indices())
-              if (!around[i]->at_boundary(f) &&
-                  (around[i]->face(f)->vertex_index(0) == v ||
-                   around[i]->face(f)->vertex_index(1) == v))
-                for (unsigned int j = 0; j < around.size(); ++j)
-                  if (around[i]->neighbor(f) == around[j])
-                    parent[find(i)] = find(j);
-          unsigned int n_groups = 0;
-          for (unsigned int i = 0; i < around.size(); ++i)
-            n_groups += find(i) == i;
-          AssertThrow(n_groups == 1,
-                      ExcMessage("Mesh: cells meet only at the vertex " +
-                                 at(triangulation.get_vertices()[v]) +
-                                 ", not along an edge (bodies joined at a "
-                                 "single point); bonded parts must share an "
-                                 "edge, parts in contact must not share "
-                                 "vertices"));
-        }
-
       // Boundary edges of one body on top of each other: a crack where
       // bonded edges do not match. Found through an R-tree of the boundary
       // faces' bounding boxes.
@@ -230,6 +194,42 @@ namespace knee_contact
                             "crack); make the vertices match or use "
                             "different groups and a contact interface"));
             }
+        }
+
+      // Around each vertex, the cells that share it must be connected
+      // through faces that contain it (Triangulation's vertex_to_cell_map).
+      const auto cells_at = GridTools::vertex_to_cell_map(triangulation);
+      for (unsigned int v = 0; v < cells_at.size(); ++v)
+        {
+          if (cells_at[v].size() < 2)
+            continue;
+          std::vector<Triangulation<2>::active_cell_iterator> around(
+            cells_at[v].begin(), cells_at[v].end());
+          std::vector<unsigned int> parent(around.size());
+          std::iota(parent.begin(), parent.end(), 0);
+          const auto find = [&](unsigned int i) {
+            while (parent[i] != i)
+              i = parent[i];
+            return i;
+          };
+          for (unsigned int i = 0; i < around.size(); ++i)
+            for (const auto f : around[i]->face_indices())
+              if (!around[i]->at_boundary(f) &&
+                  (around[i]->face(f)->vertex_index(0) == v ||
+                   around[i]->face(f)->vertex_index(1) == v))
+                for (unsigned int j = 0; j < around.size(); ++j)
+                  if (around[i]->neighbor(f) == around[j])
+                    parent[find(i)] = find(j);
+          unsigned int n_groups = 0;
+          for (unsigned int i = 0; i < around.size(); ++i)
+            n_groups += find(i) == i;
+          AssertThrow(n_groups == 1,
+                      ExcMessage("Mesh: cells meet only at the vertex " +
+                                 at(triangulation.get_vertices()[v]) +
+                                 ", not along an edge (bodies joined at a "
+                                 "single point); bonded parts must share an "
+                                 "edge, parts in contact must not share "
+                                 "vertices"));
         }
     }
   } // namespace scene_checks
