@@ -1,6 +1,7 @@
 #include <knee_contact/external_program.h>
 #include <knee_contact/gmsh_input.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
@@ -244,6 +245,7 @@ namespace knee_contact
       {
         std::unordered_set<long long> nodes;
         std::unordered_set<long long> unnamed_surfaces;
+        unsigned int                  n_named_surfaces = 0;
         bool have_entities = false, have_nodes = false, have_elements = false;
         std::vector<std::string> t;
         while (reader.next(t))
@@ -272,9 +274,21 @@ namespace knee_contact
                         if (dim == 2 && n_phys == 0)
                           unnamed_surfaces.insert(
                             reader.tag(e[0], "entity tag"));
+                        if (dim == 2 && n_phys > 0)
+                          ++n_named_surfaces;
                       }
                   }
                 reader.end_of("Entities");
+                // Gmsh saves only the cells of physical groups once there
+                // are any: the cells of other surfaces would vanish.
+                if (n_named_surfaces > 0 && !unnamed_surfaces.empty())
+                  reader.fail(
+                    "surface " +
+                    std::to_string(*std::min_element(unnamed_surfaces.begin(),
+                                                     unnamed_surfaces.end())) +
+                    " has no physical group, so its cells would be "
+                    "dropped (give every surface a Physical "
+                    "Surface)");
                 have_entities = true;
               }
             else if (t[0] == "$Nodes")
@@ -504,8 +518,11 @@ namespace knee_contact
          const double                    time_limit)
     {
       check_geo(geo);
+      // Format 4.1: its $Entities section lists every surface, so a surface
+      // without a physical group (whose cells GridIn would drop silently)
+      // can be found by check_msh.
       std::vector<std::string> command = {
-        "gmsh", "-2", "-format", "msh2", "-v", "2", "-nopopup"};
+        "gmsh", "-2", "-format", "msh41", "-v", "2", "-nopopup"};
       command.insert(command.end(), extra.begin(), extra.end());
       command.insert(command.end(), {"-o", msh, geo});
       const std::string log =

@@ -277,8 +277,7 @@ namespace knee_contact
     if (std::filesystem::path(file).extension() == ".geo")
       {
         // Mesh the .geo with the gmsh program into a private temporary
-        // folder (removed on Ctrl-C too); msh2 is the format GridIn reads
-        // most robustly.
+        // folder (removed on Ctrl-C too).
         std::string folder =
           (std::filesystem::temp_directory_path() / "knee_contact_XXXXXX")
             .string();
@@ -314,7 +313,14 @@ namespace knee_contact
     catch (const std::exception &exc)
       {
         remove_temporary();
-        AssertThrow(false, ExcMessage(exc.what()));
+        // Name the user's .geo, not the temporary file.
+        std::string message = exc.what();
+        const auto  at      = message.find("'" + msh + "'");
+        if (msh != file && at != std::string::npos)
+          message.replace(at,
+                          msh.size() + 2,
+                          "the mesh gmsh made of '" + file + "',");
+        AssertThrow(false, ExcMessage(message));
       }
 
     GridIn<2> grid_in;
