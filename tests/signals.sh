@@ -82,3 +82,14 @@ wait $pid || fail "concurrent: the first run failed"
   fail "concurrent: no complete result set after the first run"
 echo "PASS: a second run on the same folder is refused; the first completes"
 echo "PASS: $n interruptions"
+
+# A rerun after an interface was renamed: the new result set replaces the
+# old one whole, so the old interface's CSV is gone.
+old_csv=$(cd "$folder" && ls contact_*.csv | head -n 1)
+[ -n "$old_csv" ] || fail "rename: no contact CSV in the first result set"
+sed -e 's/^\( *set Name *= *\)condyle$/\1renamed_condyle/' -e 's/condyle:/renamed_condyle:/' scene.prm >renamed.prm
+grep -q renamed_condyle renamed.prm || fail "rename: no interface named condyle"
+"$program" renamed.prm >rename.log 2>&1 || fail "rename: the rerun failed: $(tail -n 1 rename.log)"
+[ -f "$folder/contact_renamed_condyle.csv" ] || fail "rename: new CSV missing"
+[ ! -e "$folder/contact_condyle.csv" ] || fail "rename: stale contact_condyle.csv left"
+echo "PASS: a renamed interface leaves no stale CSV"
