@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <limits>
+#include <sstream>
 
 namespace knee_contact
 {
@@ -159,9 +161,11 @@ namespace knee_contact
         E_min = std::min(E_min, material.youngs_modulus);
         E_max = std::max(E_max, material.youngs_modulus);
       }
+    std::ostringstream contrast;
+    contrast << std::setprecision(3) << E_max / E_min;
     AssertThrow(E_max <= 1e12 * E_min,
                 ExcMessage("Materials: the contrast of Young's moduli " +
-                           std::to_string(E_max / E_min) +
+                           contrast.str() +
                            " exceeds 1e12; the soft body's displacements "
                            "would have no correct digits (model the stiff "
                            "body as rigid with a displacement condition)"));
