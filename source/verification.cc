@@ -78,15 +78,25 @@ namespace knee_contact
                       "",
                       Patterns::Anything(),
                       "Constant expression for a(u,u) [J/m] of an overkill "
-                      "solution: its relative error is reported. Empty: "
-                      "none.");
+                      "solution: its relative error is checked against "
+                      "Energy tolerance. Empty: none.");
+    prm.declare_entry("Energy tolerance",
+                      "1e-3",
+                      Patterns::Double(0),
+                      "Allowed relative error of a(u,u) against Reference "
+                      "energy.");
     prm.declare_entry("Reference extreme stress_yy",
                       "",
                       Patterns::Anything(),
                       "'material name: value' [Pa]: the extreme (most "
                       "negative if the value is negative, else largest) "
                       "tau_yy in that material of an overkill solution; its "
-                      "relative error is reported. Empty: none.");
+                      "relative error is checked against Extreme stress "
+                      "tolerance. Empty: none.");
+    prm.declare_entry("Extreme stress tolerance",
+                      "0.05",
+                      Patterns::Double(0),
+                      "Allowed relative error of that extreme tau_yy.");
     prm.declare_entry("Reference contact forces",
                       "",
                       Patterns::Anything(),
@@ -145,11 +155,16 @@ namespace knee_contact
       reference_energy =
         input::evaluate_constant(prm.get("Reference energy"),
                                  "Verification/Reference energy");
+    energy_tolerance = prm.get_double("Energy tolerance");
+    extreme_stress_tolerance = prm.get_double("Extreme stress tolerance");
     for (const auto &[name, value] :
          input::split_named(prm.get("Reference extreme stress_yy"),
                             "Verification/Reference extreme stress_yy",
                             "material name: value"))
       {
+        AssertThrow(extreme_stress_material.empty(),
+                    ExcMessage("Verification/Reference extreme stress_yy: "
+                               "give one material, not several"));
         extreme_stress_material = name;
         extreme_stress =
           input::evaluate_constant(value,
@@ -449,6 +464,17 @@ namespace knee_contact
              last.contact_length_error,
              "<=",
              length_tolerance);
+    if (reference_energy != 0)
+      report("relative error of the energy a(u,u)",
+             last.energy_reference_relative,
+             "<=",
+             energy_tolerance);
+    if (!extreme_stress_material.empty())
+      report("relative error of the extreme tau_yy in '" +
+               extreme_stress_material + "'",
+             last.stress_extreme_relative,
+             "<=",
+             extreme_stress_tolerance);
     for (const auto &[name, force] : interface_forces)
       {
         const auto it = std::find_if(results.interfaces.begin(),

@@ -21,7 +21,11 @@ for run in a b c; do
 import json, sys
 d = json.load(open(sys.argv[1]))
 d.pop("wall_time", None)
-print(json.dumps(d, sort_keys=True))' "$work/$run/summary.json" >"$work/$run.json"
+print(json.dumps(d, sort_keys=True))' "$work/$run/summary.json" >"$work/$run.json" ||
+    { echo "FAIL: run $run wrote no readable summary.json"; exit 1; }
+  # A summary without its results would compare equal too.
+  grep -q '"energy"' "$work/$run.json" ||
+    { echo "FAIL: run $run: summary.json holds no energy"; exit 1; }
 done
 if cmp -s "$work/a.json" "$work/b.json" && cmp -s "$work/a.json" "$work/c.json"; then
   echo "PASS: summary.json identical across 2 runs with 2 threads and 1 run with 1 thread"

@@ -11,6 +11,7 @@
 #include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/lapack_full_matrix.h>
 
+#include <iomanip>
 #include <iostream>
 
 using namespace dealii;
@@ -124,6 +125,12 @@ main()
     if (problem.contact().active[p])
       pdas_set |= 1u << p;
 
+  // The energy a(x,x) of the enumerated solution: the reference that
+  // prm/hard/partial_closure.prm (the same scene) asserts.
+  Vector<double> Kx(n);
+  K.vmult(Kx, reference);
+  std::cout << "energy a(x,x) of the enumerated solution [J/m] "
+            << std::setprecision(10) << (reference * Kx) << std::endl;
   std::cout << "pairs " << M << ", free dofs " << n_free
             << ", active sets satisfying KKT: " << n_kkt_points << std::endl;
   std::cout << "active set (bit p = pair p) enumeration " << reference_set

@@ -114,6 +114,8 @@ namespace knee_contact
     double                                      contact_length   = 0;
     double                                      length_tolerance = 0;
     double                                      reference_energy = 0;
+    double                                      energy_tolerance = 1e-3;
+    double                                      extreme_stress_tolerance = 0.05;
     std::string                                 extreme_stress_material;
     double                                      extreme_stress = 0;
     std::vector<std::pair<std::string, double>> interface_forces;
