@@ -155,7 +155,7 @@ namespace knee_contact
       reference_energy =
         input::evaluate_constant(prm.get("Reference energy"),
                                  "Verification/Reference energy");
-    energy_tolerance = prm.get_double("Energy tolerance");
+    energy_tolerance         = prm.get_double("Energy tolerance");
     extreme_stress_tolerance = prm.get_double("Extreme stress tolerance");
     for (const auto &[name, value] :
          input::split_named(prm.get("Reference extreme stress_yy"),

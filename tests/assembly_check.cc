@@ -48,13 +48,13 @@ namespace
                     const double E,
                     const double nu)
   {
-    const double lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
-    const double mu     = E / (2 * (1 + nu));
-    const double D[3][3] = {{lambda + 2 * mu, lambda, 0},
-                            {lambda, lambda + 2 * mu, 0},
-                            {0, 0, mu}};
-    const double sx[4] = {-1, 1, -1, 1}, sy[4] = {-1, -1, 1, 1};
-    const double g     = 1 / std::sqrt(3.);
+    const double       lambda  = E * nu / ((1 + nu) * (1 - 2 * nu));
+    const double       mu      = E / (2 * (1 + nu));
+    const double       D[3][3] = {{lambda + 2 * mu, lambda, 0},
+                                  {lambda, lambda + 2 * mu, 0},
+                                  {0, 0, mu}};
+    const double       sx[4] = {-1, 1, -1, 1}, sy[4] = {-1, -1, 1, 1};
+    const double       g = 1 / std::sqrt(3.);
     FullMatrix<double> K(8, 8);
     for (const double xi : {-g, g})
       for (const double eta : {-g, g})
@@ -65,10 +65,10 @@ namespace
             {
               const double dNdx = sx[a] * (1 + sy[a] * eta) / 4 * 2 / hx;
               const double dNdy = sy[a] * (1 + sx[a] * xi) / 4 * 2 / hy;
-              B[0][2 * a]     = dNdx;
-              B[1][2 * a + 1] = dNdy;
-              B[2][2 * a]     = dNdy;
-              B[2][2 * a + 1] = dNdx;
+              B[0][2 * a]       = dNdx;
+              B[1][2 * a + 1]   = dNdy;
+              B[2][2 * a]       = dNdy;
+              B[2][2 * a + 1]   = dNdx;
             }
           const double w = hx * hy / 4; // weights 1, Jacobian hx hy / 4
           for (unsigned int i = 0; i < 8; ++i)
@@ -111,10 +111,10 @@ main()
     std::exit(1);
   };
 
-  const std::array<Block, 2> blocks = {{{0, 0, 2, 1, 3, 2, 1e9, 0.3},
-                                        {0, 1, 2, 1.5, 4, 1, 2e9, 0.25}}};
-  FullMatrix<double>         K(n, n);
-  Vector<double>             f(n);
+  const std::array<Block, 2> blocks = {
+    {{0, 0, 2, 1, 3, 2, 1e9, 0.3}, {0, 1, 2, 1.5, 4, 1, 2e9, 0.25}}};
+  FullMatrix<double> K(n, n);
+  Vector<double>     f(n);
   for (const Block &b : blocks)
     {
       const double hx = (b.x1 - b.x0) / b.nx, hy = (b.y1 - b.y0) / b.ny;
@@ -122,13 +122,12 @@ main()
       for (unsigned int i = 0; i < b.nx; ++i)
         for (unsigned int j = 0; j < b.ny; ++j)
           {
-            const Point<2> lower(b.x0 + i * hx, b.y0 + j * hy);
-            const Point<2> centre = lower + Point<2>(hx / 2, hy / 2);
-            std::array<Point<2>, 4> corner = {
-              {lower,
-               lower + Point<2>(hx, 0),
-               lower + Point<2>(0, hy),
-               lower + Point<2>(hx, hy)}};
+            const Point<2>          lower(b.x0 + i * hx, b.y0 + j * hy);
+            const Point<2>          centre = lower + Point<2>(hx / 2, hy / 2);
+            std::array<Point<2>, 4> corner = {{lower,
+                                               lower + Point<2>(hx, 0),
+                                               lower + Point<2>(0, hy),
+                                               lower + Point<2>(hx, hy)}};
             std::array<types::global_dof_index, 8> index;
             for (unsigned int a = 0; a < 4; ++a)
               for (unsigned int d = 0; d < 2; ++d)
@@ -139,7 +138,7 @@ main()
             // Traction on the top of the upper block.
             if (b.y1 == 1.5 && j + 1 == b.ny)
               {
-                const auto   t  = [](const double x) { return -1e6 * (x - 0.8); };
+                const auto t = [](const double x) { return -1e6 * (x - 0.8); };
                 const double xa = corner[2][0], xb = corner[3][0];
                 f(index[5]) += hx * (2 * t(xa) + t(xb)) / 6;
                 f(index[7]) += hx * (t(xa) + 2 * t(xb)) / 6;
@@ -148,18 +147,17 @@ main()
     }
 
   // Contact rows: slave = the upper block's bottom vertices.
-  const unsigned int                 n_slave = 5, n_master = 4;
-  std::vector<Vector<double>>        rows(n_slave, Vector<double>(n));
-  std::vector<double>                lengths(n_slave);
-  std::vector<Point<2>>              positions(n_slave);
+  const unsigned int          n_slave = 5, n_master = 4;
+  std::vector<Vector<double>> rows(n_slave, Vector<double>(n));
+  std::vector<double>         lengths(n_slave);
+  std::vector<Point<2>>       positions(n_slave);
   for (unsigned int s = 0; s < n_slave; ++s)
     {
       const double   hs = 0.5, hm = 2. / 3;
       const Point<2> xs(s * hs, 1);
       positions[s] = xs;
       lengths[s]   = (s == 0 || s + 1 == n_slave) ? hs / 2 : hs;
-      const Point<2> slave_cell(std::min(s, n_slave - 2) * hs + hs / 2,
-                                1.25);
+      const Point<2> slave_cell(std::min(s, n_slave - 2) * hs + hs / 2, 1.25);
       // n . u_s with n = (0, -1)
       rows[s](dof_at(slave_cell, xs, 1)) += -1;
       const unsigned int m =
@@ -175,7 +173,7 @@ main()
   K_program.copy_from(problem.matrix());
   FullMatrix<double> dK(K_program);
   dK.add(-1, K);
-  const double matrix_error = max_abs(dK) / max_abs(K);
+  const double   matrix_error = max_abs(dK) / max_abs(K);
   Vector<double> df(problem.rhs());
   df -= f;
   const double load_error = df.linfty_norm() / f.linfty_norm();
@@ -193,10 +191,10 @@ main()
           for (const auto &[dof, a] : pair.row)
             row(dof) += a;
           row -= rows[s];
-          row_error    = std::max(row_error, row.linfty_norm());
-          gap_error    = std::max(gap_error, std::abs(pair.gap));
-          length_error = std::max(length_error,
-                                  std::abs(pair.length - lengths[s]));
+          row_error = std::max(row_error, row.linfty_norm());
+          gap_error = std::max(gap_error, std::abs(pair.gap));
+          length_error =
+            std::max(length_error, std::abs(pair.length - lengths[s]));
         }
 
   std::cout << "pairs " << pairs.size() << " (formula " << n_slave
