@@ -1,4 +1,5 @@
 #include <knee_contact/contact.h>
+#include <knee_contact/contact_sides.h>
 #include <knee_contact/input.h>
 
 #include <deal.II/lac/vector.h>
@@ -23,6 +24,23 @@ namespace knee_contact
       },
       '_');
     return "contact_" + name + ".csv";
+  }
+
+
+
+  std::string
+  pairing_name(const Pairing pairing)
+  {
+    switch (pairing)
+      {
+        case Pairing::mortar:
+          return "mortar";
+        case Pairing::node_to_segment:
+          return "node-to-segment";
+        case Pairing::node_to_node:
+          return "node-to-node";
+      }
+    return "";
   }
 
 
@@ -64,14 +82,17 @@ namespace knee_contact
                           "0",
                           Patterns::Integer(0, 254),
                           "Boundary id of the side of body l.");
-        prm.declare_entry("Pairing",
-                          "node-to-segment",
-                          Patterns::Selection("node-to-segment|node-to-node"),
-                          "node-to-segment: each slave vertex is paired with "
-                          "the point of the master side along its normal "
-                          "(non-matching meshes, initial gaps); "
-                          "node-to-node: the seed's node pairs, every slave "
-                          "vertex must coincide with a master vertex.");
+        prm.declare_entry(
+          "Pairing",
+          "mortar",
+          Patterns::Selection("mortar|node-to-segment|node-to-node"),
+          "mortar: dual mortar (segment-to-segment) conditions, one per "
+          "slave vertex, weighted by the biorthogonal multiplier basis; "
+          "exact contact pressure for the patch test on non-matching "
+          "meshes, either side slave. node-to-segment: each slave vertex is "
+          "paired with the point of the master side along its normal. "
+          "node-to-node: the seed's node pairs, every slave vertex must "
+          "coincide with a master vertex.");
         prm.declare_entry("Maximum gap",
                           "0",
                           Patterns::Double(0),
@@ -100,7 +121,10 @@ namespace knee_contact
           static_cast<types::boundary_id>(prm.get_integer("Slave boundary id"));
         interface.master_id = static_cast<types::boundary_id>(
           prm.get_integer("Master boundary id"));
-        interface.node_to_node = prm.get("Pairing") == "node-to-node";
+        const std::string pairing = prm.get("Pairing");
+        interface.pairing = pairing == "mortar"          ? Pairing::mortar :
+                            pairing == "node-to-segment" ? Pairing::node_to_segment :
+                                                           Pairing::node_to_node;
         interface.maximum_gap  = prm.get_double("Maximum gap");
         const std::string where =
           "Contact/Interface " + std::to_string(i) + ": ";
@@ -174,21 +198,6 @@ namespace knee_contact
 
   namespace
   {
-    struct SlaveVertex
-    {
-      Point<2>                               position;
-      Tensor<1, 2>                           normal;
-      double                                 length = 0;
-      std::array<types::global_dof_index, 2> dofs;
-    };
-
-    struct MasterSegment
-    {
-      std::array<Point<2>, 2>                               vertices;
-      std::array<std::array<types::global_dof_index, 2>, 2> dofs;
-      Tensor<1, 2>                                          normal;
-    };
-
     // Outward normal of a boundary face of a cell, with the face's length
     // as its norm (so that summing over a vertex's faces weights by length).
     Tensor<1, 2>
@@ -228,7 +237,131 @@ namespace knee_contact
           pair.reduced_row.push_back(entry);
       pair.reduced_gap = rhs;
     }
+
+    ContactSides
+    collect_sides(const DoFHandler<2>    &dof_handler,
+                  const ContactInterface &interface)
+    {
+      ContactSides sides;
+      sides.min_length = std::numeric_limits<double>::max();
+      for (const auto &cell : dof_handler.active_cell_iterators())
+        for (const unsigned int f : cell->face_indices())
+          if (cell->face(f)->at_boundary())
+            {
+              const auto         face = cell->face(f);
+              const Tensor<1, 2> n    = outward_normal(cell, f);
+              ContactSides::Face side;
+              for (unsigned int v = 0; v < 2; ++v)
+                {
+                  side.vertex_keys[v] = face->vertex_index(v);
+                  side.vertices[v]    = face->vertex(v);
+                  side.dofs[v]        = {{face->vertex_dof_index(v, 0),
+                                          face->vertex_dof_index(v, 1)}};
+                }
+              side.normal = n / n.norm();
+              if (face->boundary_id() == interface.slave_id)
+                {
+                  for (unsigned int v = 0; v < 2; ++v)
+                    {
+                      auto &s    = sides.slaves[side.vertex_keys[v]];
+                      s.position = side.vertices[v];
+                      s.normal += n; // length-weighted: |n| = face length
+                      s.length += 0.5 * n.norm();
+                      s.dofs = side.dofs[v];
+                    }
+                  sides.min_length = std::min(sides.min_length, n.norm());
+                  sides.slave_faces.push_back(side);
+                }
+              else if (face->boundary_id() == interface.master_id)
+                sides.master_faces.push_back(side);
+            }
+      return sides;
+    }
   } // namespace
+
+
+
+  std::vector<ContactPair>
+  node_to_segment_rows(const ContactSides     &sides,
+                       const ContactInterface &interface,
+                       const unsigned int      interface_index,
+                       const std::string      &where)
+  {
+    std::vector<ContactPair> pairs;
+    for (const auto &[vertex, slave] : sides.slaves)
+      {
+        const Tensor<1, 2> n   = slave.normal / slave.normal.norm();
+        const double       tol = 1e-8 * sides.min_length;
+        // Node-to-segment: x + s n = p0 + xi (p1 - p0), the closest
+        // master face facing the slave (n_master . n < 0) along n.
+        double best_s = std::numeric_limits<double>::max(), best_xi = 0;
+        const ContactSides::Face *best = nullptr;
+        for (const ContactSides::Face &m : sides.master_faces)
+          {
+            if (m.normal * n >= 0)
+              continue;
+            const Tensor<1, 2> t   = m.vertices[1] - m.vertices[0];
+            const Tensor<1, 2> r   = m.vertices[0] - slave.position;
+            const double       det = -n[0] * t[1] + n[1] * t[0];
+            if (std::abs(det) < 1e-12 * t.norm())
+              continue;
+            const double s  = (-r[0] * t[1] + r[1] * t[0]) / det;
+            const double xi = (n[0] * r[1] - n[1] * r[0]) / det;
+            if (xi < -1e-10 || xi > 1 + 1e-10 || s < -2 * slave.length)
+              continue;
+            if (std::abs(s) < std::abs(best_s))
+              {
+                best_s  = s;
+                best_xi = std::clamp(xi, 0., 1.);
+                best    = &m;
+              }
+          }
+        if (best != nullptr && std::abs(best_s) <= tol)
+          best_s = 0;
+        if (best != nullptr && (best_xi < 1e-8 || best_xi > 1 - 1e-8) &&
+            best_s == 0)
+          best_xi = std::round(best_xi);
+        if (interface.pairing == Pairing::node_to_node)
+          AssertThrow(best != nullptr && best_s == 0 &&
+                        (best_xi == 0 || best_xi == 1),
+                      ExcMessage(where +
+                                 "node-to-node pairing: slave "
+                                 "vertex at (" +
+                                 std::to_string(slave.position[0]) + ", " +
+                                 std::to_string(slave.position[1]) +
+                                 ") has no coincident master vertex"));
+        if (best == nullptr ||
+            (interface.maximum_gap > 0 && best_s > interface.maximum_gap))
+          continue;
+        AssertThrow(best_s >= -tol,
+                    ExcMessage(where + "slave vertex at (" +
+                               std::to_string(slave.position[0]) + ", " +
+                               std::to_string(slave.position[1]) +
+                               ") penetrates the master side by " +
+                               std::to_string(-best_s) +
+                               " m; initial overlap is not supported"));
+
+        ContactPair pair;
+        pair.interface    = interface_index;
+        pair.position     = slave.position;
+        pair.normal       = n;
+        pair.gap          = best_s;
+        pair.master_point = slave.position + best_s * n;
+        pair.length       = slave.length;
+        pair.slave_dofs   = slave.dofs;
+        for (unsigned int d = 0; d < 2; ++d)
+          pair.row.emplace_back(slave.dofs[d], n[d]);
+        for (unsigned int v = 0; v < 2; ++v)
+          {
+            const double weight = v == 0 ? 1 - best_xi : best_xi;
+            if (weight != 0)
+              for (unsigned int d = 0; d < 2; ++d)
+                pair.row.emplace_back(best->dofs[v][d], -weight * n[d]);
+          }
+        pairs.push_back(pair);
+      }
+    return pairs;
+  }
 
 
 
@@ -241,126 +374,30 @@ namespace knee_contact
     std::set<types::global_dof_index> eliminated;
     for (unsigned int i = 0; i < list.size(); ++i)
       {
-        const ContactInterface             &interface = list[i];
-        std::map<unsigned int, SlaveVertex> slaves;
-        std::vector<MasterSegment>          masters;
-        double min_length = std::numeric_limits<double>::max();
-        for (const auto &cell : dof_handler.active_cell_iterators())
-          for (const unsigned int f : cell->face_indices())
-            if (cell->face(f)->at_boundary())
-              {
-                const auto         face = cell->face(f);
-                const Tensor<1, 2> n    = outward_normal(cell, f);
-                if (face->boundary_id() == interface.slave_id)
-                  for (unsigned int v = 0; v < 2; ++v)
-                    {
-                      SlaveVertex &s = slaves[face->vertex_index(v)];
-                      s.position     = face->vertex(v);
-                      s.normal += n; // length-weighted: |n| = face length
-                      s.length += 0.5 * n.norm();
-                      s.dofs     = {{face->vertex_dof_index(v, 0),
-                                     face->vertex_dof_index(v, 1)}};
-                      min_length = std::min(min_length, n.norm());
-                    }
-                else if (face->boundary_id() == interface.master_id)
-                  {
-                    MasterSegment m;
-                    for (unsigned int v = 0; v < 2; ++v)
-                      {
-                        m.vertices[v] = face->vertex(v);
-                        m.dofs[v]     = {{face->vertex_dof_index(v, 0),
-                                          face->vertex_dof_index(v, 1)}};
-                      }
-                    m.normal = n / n.norm();
-                    masters.push_back(m);
-                  }
-              }
-        const std::string where = "Contact/Interface " + std::to_string(i) +
-                                  " ('" + interface.name + "'): ";
-        AssertThrow(!slaves.empty() && !masters.empty(),
+        const ContactInterface &interface = list[i];
+        const ContactSides      sides = collect_sides(dof_handler, interface);
+        const std::string       where = "Contact/Interface " +
+                                  std::to_string(i) + " ('" + interface.name +
+                                  "'): ";
+        AssertThrow(!sides.slaves.empty() && !sides.master_faces.empty(),
                     ExcMessage(where + "a side has no faces"));
+        std::vector<ContactPair> rows =
+          interface.pairing == Pairing::mortar ?
+            mortar_rows(sides, interface, i, where) :
+            node_to_segment_rows(sides, interface, i, where);
 
-        for (const auto &[vertex, slave] : slaves)
+        for (ContactPair &pair : rows)
           {
-            const Tensor<1, 2> n   = slave.normal / slave.normal.norm();
-            const double       tol = 1e-8 * min_length;
-            // Node-to-segment: x + s n = p0 + xi (p1 - p0), the closest
-            // master face facing the slave (n_master . n < 0) along n.
-            double best_s = std::numeric_limits<double>::max(), best_xi = 0;
-            const MasterSegment *best = nullptr;
-            for (const MasterSegment &m : masters)
-              {
-                if (m.normal * n >= 0)
-                  continue;
-                const Tensor<1, 2> t   = m.vertices[1] - m.vertices[0];
-                const Tensor<1, 2> r   = m.vertices[0] - slave.position;
-                const double       det = -n[0] * t[1] + n[1] * t[0];
-                if (std::abs(det) < 1e-12 * t.norm())
-                  continue;
-                const double s  = (-r[0] * t[1] + r[1] * t[0]) / det;
-                const double xi = (n[0] * r[1] - n[1] * r[0]) / det;
-                if (xi < -1e-10 || xi > 1 + 1e-10 || s < -2 * slave.length)
-                  continue;
-                if (std::abs(s) < std::abs(best_s))
-                  {
-                    best_s  = s;
-                    best_xi = std::clamp(xi, 0., 1.);
-                    best    = &m;
-                  }
-              }
-            if (best != nullptr && std::abs(best_s) <= tol)
-              best_s = 0;
-            if (best != nullptr && (best_xi < 1e-8 || best_xi > 1 - 1e-8) &&
-                best_s == 0)
-              best_xi = std::round(best_xi);
-            if (interface.node_to_node)
-              AssertThrow(best != nullptr && best_s == 0 &&
-                            (best_xi == 0 || best_xi == 1),
-                          ExcMessage(where +
-                                     "node-to-node pairing: slave "
-                                     "vertex at (" +
-                                     std::to_string(slave.position[0]) + ", " +
-                                     std::to_string(slave.position[1]) +
-                                     ") has no coincident master vertex"));
-            if (best == nullptr ||
-                (interface.maximum_gap > 0 && best_s > interface.maximum_gap))
-              continue;
-            AssertThrow(best_s >= -tol,
-                        ExcMessage(where + "slave vertex at (" +
-                                   std::to_string(slave.position[0]) + ", " +
-                                   std::to_string(slave.position[1]) +
-                                   ") penetrates the master side by " +
-                                   std::to_string(-best_s) +
-                                   " m; initial overlap is not supported"));
-
-            ContactPair pair;
-            pair.interface    = i;
-            pair.position     = slave.position;
-            pair.normal       = n;
-            pair.gap          = best_s;
-            pair.master_point = slave.position + best_s * n;
-            pair.length       = slave.length;
-            pair.slave_dofs   = slave.dofs;
-            for (unsigned int d = 0; d < 2; ++d)
-              pair.row.emplace_back(slave.dofs[d], n[d]);
-            for (unsigned int v = 0; v < 2; ++v)
-              {
-                const double weight = v == 0 ? 1 - best_xi : best_xi;
-                if (weight != 0)
-                  for (unsigned int d = 0; d < 2; ++d)
-                    pair.row.emplace_back(best->dofs[v][d], -weight * n[d]);
-              }
             reduce_row(pair, constraints);
-
             // Eliminate the free slave component with the largest |n|,
-            // else the largest free master component.
+            // else the largest free other component.
             for (const bool slave_side : {true, false})
               {
                 double largest = 0;
                 for (const auto &[dof, a] : pair.reduced_row)
                   {
                     const bool on_slave =
-                      dof == slave.dofs[0] || dof == slave.dofs[1];
+                      dof == pair.slave_dofs[0] || dof == pair.slave_dofs[1];
                     if (on_slave == slave_side && !eliminated.count(dof) &&
                         std::abs(a) > largest + 1e-12)
                       {
@@ -373,7 +410,7 @@ namespace knee_contact
               }
             if (pair.eliminated != numbers::invalid_dof_index)
               eliminated.insert(pair.eliminated);
-            pairs.push_back(pair);
+            pairs.push_back(std::move(pair));
           }
       }
     return pairs;

@@ -69,13 +69,30 @@ namespace knee_contact
 
 
 
+  /**
+   * How an interface's contact conditions are discretised (the seam: each
+   * has its row builder in contact_sides.h).
+   */
+  enum class Pairing
+  {
+    mortar,
+    node_to_segment,
+    node_to_node
+  };
+
+  /** The name of a Pairing as in the scene files. */
+  std::string
+  pairing_name(const Pairing pairing);
+
+
+
   struct ContactInterface
   {
     std::string        name;
-    types::boundary_id slave_id     = 0;
-    types::boundary_id master_id    = 0;
-    bool               node_to_node = false;
-    double             maximum_gap  = 0;
+    types::boundary_id slave_id    = 0;
+    types::boundary_id master_id   = 0;
+    Pairing            pairing     = Pairing::mortar;
+    double             maximum_gap = 0;
   };
 
 

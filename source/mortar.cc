@@ -1,0 +1,212 @@
+// Dual mortar contact rows (segment-to-segment). No library in reach builds
+// mortar integrals for deal.II's contact of separate bodies (deal.II has no
+// contact; Kratos, MOOSE, CalculiX do it inside their own data structures),
+// so they are written here for 2D linear faces.
+//
+// The multiplier lives on the slave side in the dual basis of the linear
+// trace space: on a slave face with shape functions phi_a = 1 - xi,
+// phi_b = xi, psi_a = 3 phi_a - 1, psi_b = 3 phi_b - 1, so that
+// int psi_j phi_i = delta_ij int phi_i (biorthogonal) and psi_a + psi_b = 1.
+// For a slave vertex j with averaged unit normal n_j, the weighted
+// condition is
+//   sum_i D_ji n_j.u_i - sum_k M_jk n_j.u_k <= g~_j,
+//   D_ji = int psi_j phi_i,  M_jk = int psi_j phi_k^master,
+//   g~_j = int psi_j (x_master - x_slave).n_j,
+// integrated over the pieces of the slave faces that the master faces'
+// orthogonal projections cut (on each piece every integrand is a product
+// of two affine functions, so 2-point Gauss is exact: no quadrature across
+// kinks). Where a slave face is fully covered D is diagonal. Each row is
+// divided by its weight W_j = sum_i D_ji = int psi_j, so that it reads like
+// a node-to-segment row (own normal displacement minus a weighted mean of
+// the master's) and the multiplier divided by ContactPair::length = W_j is
+// the coefficient of the pressure in the dual basis: a constant pressure p
+// gives exactly p at every vertex.
+
+#include <knee_contact/contact_sides.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <utility>
+
+namespace knee_contact
+{
+  namespace
+  {
+    struct Accumulator
+    {
+      std::map<unsigned int, double>                           slave;
+      std::map<std::array<types::global_dof_index, 2>, double> master;
+      double                                                   gap = 0;
+    };
+
+    // The parts of [lo, hi] not covered by the intervals in taken.
+    std::vector<std::pair<double, double>>
+    uncovered(const double                                  lo,
+              const double                                  hi,
+              const std::vector<std::pair<double, double>> &taken)
+    {
+      std::vector<std::pair<double, double>> pieces = {{lo, hi}};
+      for (const auto &[t0, t1] : taken)
+        {
+          std::vector<std::pair<double, double>> next;
+          for (const auto &[p0, p1] : pieces)
+            {
+              if (t1 <= p0 || t0 >= p1)
+                next.emplace_back(p0, p1);
+              else
+                {
+                  if (t0 > p0)
+                    next.emplace_back(p0, t0);
+                  if (t1 < p1)
+                    next.emplace_back(t1, p1);
+                }
+            }
+          pieces = next;
+        }
+      return pieces;
+    }
+  } // namespace
+
+
+
+  std::vector<ContactPair>
+  mortar_rows(const ContactSides     &sides,
+              const ContactInterface &interface,
+              const unsigned int      interface_index,
+              const std::string      &where)
+  {
+    std::map<unsigned int, Accumulator> rows;
+    const double                        g = 1 / std::sqrt(3.);
+
+    for (const ContactSides::Face &slave : sides.slave_faces)
+      {
+        const Point<2>    &xa = slave.vertices[0];
+        const Tensor<1, 2> e  = slave.vertices[1] - xa;
+        const double       L  = e.norm();
+        // The master faces facing this slave face, with the slave
+        // parameter interval their projection covers, nearest first.
+        struct Candidate
+        {
+          double                     lo, hi, xi_c, xi_d, distance;
+          const ContactSides::Face *master;
+        };
+        std::vector<Candidate> candidates;
+        for (const ContactSides::Face &master : sides.master_faces)
+          {
+            if (master.normal * slave.normal >= 0)
+              continue;
+            const double xi_c = (master.vertices[0] - xa) * e / (L * L);
+            const double xi_d = (master.vertices[1] - xa) * e / (L * L);
+            if (std::abs(xi_d - xi_c) < 1e-12)
+              continue;
+            const double lo = std::max(0., std::min(xi_c, xi_d));
+            const double hi = std::min(1., std::max(xi_c, xi_d));
+            if (hi - lo < 1e-12)
+              continue;
+            const double   xi  = 0.5 * (lo + hi);
+            const double   eta = (xi - xi_c) / (xi_d - xi_c);
+            const Point<2> xm =
+              master.vertices[0] + eta * (master.vertices[1] - master.vertices[0]);
+            const double s = (xm - (xa + xi * e)) * slave.normal;
+            if (s < -L ||
+                (interface.maximum_gap > 0 && s > interface.maximum_gap))
+              continue;
+            candidates.push_back({lo, hi, xi_c, xi_d, std::abs(s), &master});
+          }
+        std::sort(candidates.begin(),
+                  candidates.end(),
+                  [](const Candidate &a, const Candidate &b) {
+                    return a.distance < b.distance;
+                  });
+
+        std::vector<std::pair<double, double>> taken;
+        for (const Candidate &c : candidates)
+          {
+            for (const auto &[p0, p1] : uncovered(c.lo, c.hi, taken))
+              {
+                if (p1 - p0 < 1e-12)
+                  continue;
+                for (const double q : {-g, g})
+                  {
+                    const double xi  = 0.5 * (p0 + p1) + 0.5 * (p1 - p0) * q;
+                    const double w   = 0.5 * (p1 - p0) * L;
+                    const double eta = (xi - c.xi_c) / (c.xi_d - c.xi_c);
+                    const std::array<double, 2> phi = {{1 - xi, xi}};
+                    const std::array<double, 2> psi = {{2 - 3 * xi,
+                                                        3 * xi - 1}};
+                    const std::array<double, 2> phi_master = {{1 - eta, eta}};
+                    const Point<2> xs = xa + xi * e;
+                    const Point<2> xm =
+                      c.master->vertices[0] +
+                      eta * (c.master->vertices[1] - c.master->vertices[0]);
+                    for (unsigned int j = 0; j < 2; ++j)
+                      {
+                        const unsigned int key = slave.vertex_keys[j];
+                        const Tensor<1, 2> &n_sum =
+                          sides.slaves.at(key).normal;
+                        const Tensor<1, 2> n = n_sum / n_sum.norm();
+                        Accumulator       &row = rows[key];
+                        for (unsigned int i = 0; i < 2; ++i)
+                          row.slave[slave.vertex_keys[i]] +=
+                            w * psi[j] * phi[i];
+                        for (unsigned int k = 0; k < 2; ++k)
+                          row.master[c.master->dofs[k]] +=
+                            w * psi[j] * phi_master[k];
+                        row.gap += w * psi[j] * ((xm - xs) * n);
+                      }
+                  }
+              }
+            taken.emplace_back(c.lo, c.hi);
+          }
+      }
+
+    std::vector<ContactPair> pairs;
+    for (const auto &[key, row] : rows)
+      {
+        const ContactSides::SlaveVertex &vertex = sides.slaves.at(key);
+        double                           weight = 0;
+        for (const auto &entry : row.slave)
+          weight += entry.second;
+        // A vertex whose faces the master covers for less than a quarter of
+        // its weight (at an interface end that overhangs the master) gets
+        // no row: int psi_j over a small end piece can be tiny or negative.
+        if (weight < 0.25 * vertex.length)
+          continue;
+        const Tensor<1, 2> n   = vertex.normal / vertex.normal.norm();
+        const double       gap = row.gap / weight;
+        const double       tol = 1e-8 * sides.min_length;
+        AssertThrow(gap >= -tol,
+                    ExcMessage(where + "slave vertex at (" +
+                               std::to_string(vertex.position[0]) + ", " +
+                               std::to_string(vertex.position[1]) +
+                               ") penetrates the master side by " +
+                               std::to_string(-gap) +
+                               " m (weighted mortar gap); initial overlap is "
+                               "not supported"));
+        ContactPair pair;
+        pair.interface    = interface_index;
+        pair.position     = vertex.position;
+        pair.normal       = n;
+        pair.gap          = std::abs(gap) <= tol ? 0. : gap;
+        pair.master_point = vertex.position + pair.gap * n;
+        pair.length       = weight;
+        pair.slave_dofs   = vertex.dofs;
+        // The vertex's own dofs first (the elimination prefers them).
+        for (unsigned int d = 0; d < 2; ++d)
+          pair.row.emplace_back(vertex.dofs[d],
+                                row.slave.at(key) / weight * n[d]);
+        for (const auto &[other, D] : row.slave)
+          if (other != key && D != 0)
+            for (unsigned int d = 0; d < 2; ++d)
+              pair.row.emplace_back(sides.slaves.at(other).dofs[d],
+                                    D / weight * n[d]);
+        for (const auto &[dofs, M] : row.master)
+          if (M != 0)
+            for (unsigned int d = 0; d < 2; ++d)
+              pair.row.emplace_back(dofs[d], -M / weight * n[d]);
+        pairs.push_back(pair);
+      }
+    return pairs;
+  }
+} // namespace knee_contact
