@@ -151,7 +151,14 @@ namespace knee_contact
       motion << "rotation about (" << centre[body][0] - ty / omega << ", "
              << centre[body][1] + tx / omega << ")";
     else
-      motion << "translation along (" << tx / t << ", " << ty / t << ")";
+      {
+        // Components at round-off of the unit direction are shown as 0.
+        const auto shown = [](const double c) {
+          return std::abs(c) < 1e-12 ? 0. : c;
+        };
+        motion << "translation along (" << shown(tx / t) << ", "
+               << shown(ty / t) << ")";
+      }
     return "body " + std::to_string(body) + " (" + names[body] +
            ") is not held: its " + motion.str() +
            " is free of every displacement, sliding and active contact "

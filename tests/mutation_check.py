@@ -47,9 +47,6 @@ EXEMPT = [
     ("uniaxial_block_msh41.prm", r"^geometry:", "as uniaxial_block.prm"),
     ("sliding_rotated_square.prm", r"^geometry:",
      "homogeneous strain: u = eps x on a square of any size"),
-    ("contact_patch_nonmatching.prm", r".",
-     "node-to-segment does not pass this patch test (6 % energy error); "
-     "exact once mortar contact lands (issue 10)"),
     # Measured sensitivities (tests/knee_small.prm, knee_frontal_small.prm:
     # relative change of a(u,u) / of the peak pressures under x 1.01):
     # bone nu 1.9e-4 / 2.8e-4; Ti6Al4V E 8.1e-5 / 7.0e-5, nu 1.9e-5 /
