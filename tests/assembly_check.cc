@@ -18,12 +18,14 @@
 // The program's DoFHandler is used only to find the dof index of a vertex of
 // a cell (cells matched by centre, vertices by position).
 // Asserted: matrix, load and rows equal to 1e-12 relative to their largest
-// entries, the same pairs, the same gaps and lengths.
+// entries, the same pairs, the same gaps and lengths; and the mortar rows of
+// the same scene (see below).
 
 #include <knee_contact/problem.h>
 
 #include <deal.II/lac/full_matrix.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <iostream>
@@ -212,5 +214,82 @@ main()
   report("contact rows, max |a_p - a_formula|", row_error);
   report("gaps, max |g_p|", gap_error);
   report("slave length shares, max |l_p - l_formula|", length_error);
+
+  // Mortar rows of the same scene (qp_scene_mortar.prm): for slave vertex j,
+  // with the global dual function psi_j (3 phi_j - 1 on each slave face at
+  // j, 0 elsewhere) and the master hat functions phi_k,
+  //   row_j = n.u_j - sum_k (M_jk / W_j) n.u_k,  M_jk = int psi_j phi_k,
+  //   W_j = int psi_j (= the vertex's length share), gap 0 (flat, touching),
+  // integrated here by Simpson's rule between all slave and master vertices
+  // (the integrand is quadratic on each piece, so Simpson is exact): a
+  // different rule and a global instead of a face-by-face formulation.
+  ContactProblem mortar(SOURCE_DIR "/qp_scene_mortar.prm");
+  pass                             = pass && mortar.run() == 0;
+  const DoFHandler<2> &mortar_dofs = mortar.dof_handler_of();
+  const auto           mortar_dof  = [&](const Point<2> &c, const Point<2> &p) {
+    for (const auto &cell : mortar_dofs.active_cell_iterators())
+      if (cell->center().distance(c) < 1e-12)
+        for (const unsigned int v : cell->vertex_indices())
+          if (cell->vertex(v).distance(p) < 1e-12)
+            return cell->vertex_dof_index(v, 1);
+    std::cerr << "no vertex " << p << " in the cell at " << c << std::endl;
+    std::exit(1);
+  };
+  const double hs = 0.5, hm = 2. / 3;
+  const auto   hat = [](const double x, const double node, const double h) {
+    return std::max(0., 1 - std::abs(x - node) / h);
+  };
+  const auto psi = [&](const unsigned int j, const double x) {
+    // The slave face holding x (x inside a face, never at a vertex here).
+    const double face = std::floor(x / hs);
+    if (j != face && j != face + 1)
+      return 0.;
+    return 3 * hat(x, j * hs, hs) - 1;
+  };
+  std::vector<double> breaks = {0, hm, 2 * hm, 2};
+  for (unsigned int s = 0; s < n_slave; ++s)
+    breaks.push_back(s * hs);
+  std::sort(breaks.begin(), breaks.end());
+  double mortar_error = mortar.pairs().size() == n_slave ? 0 : 1;
+  for (const auto &pair : mortar.pairs())
+    {
+      const unsigned int  j = std::lround(pair.position[0] / hs);
+      Vector<double>      expected(mortar_dofs.n_dofs());
+      double              W = 0;
+      std::vector<double> M(n_master);
+      for (unsigned int b = 0; b + 1 < breaks.size(); ++b)
+        {
+          const double x0 = breaks[b], x1 = breaks[b + 1];
+          if (x1 - x0 < 1e-14)
+            continue;
+          for (const auto &[x, w] : {std::pair{x0 + 1e-14, 1.},
+                                     std::pair{0.5 * (x0 + x1), 4.},
+                                     std::pair{x1 - 1e-14, 1.}})
+            {
+              const double weight = w * (x1 - x0) / 6;
+              W += weight * psi(j, x);
+              for (unsigned int k = 0; k < n_master; ++k)
+                M[k] += weight * psi(j, x) * hat(x, k * hm, hm);
+            }
+        }
+      const Point<2> slave_cell(std::min(j, n_slave - 2) * hs + hs / 2, 1.25);
+      expected(mortar_dof(slave_cell, Point<2>(j * hs, 1))) += -1;
+      for (unsigned int k = 0; k < n_master; ++k)
+        {
+          const Point<2> master_cell(std::min(k, n_master - 2) * hm + hm / 2,
+                                     0.75);
+          expected(mortar_dof(master_cell, Point<2>(k * hm, 1))) += M[k] / W;
+        }
+      Vector<double> row(mortar_dofs.n_dofs());
+      for (const auto &[dof, a] : pair.row)
+        row(dof) += a;
+      row -= expected;
+      mortar_error = std::max({mortar_error,
+                               row.linfty_norm(),
+                               std::abs(pair.gap),
+                               std::abs(pair.length - W)});
+    }
+  std::cout << "mortar pairs " << mortar.pairs().size() << std::endl;
+  report("mortar rows, gaps and weights, max difference", mortar_error);
   return pass ? 0 : 1;
 }

@@ -4,7 +4,8 @@
 // equality-constrained QP is solved densely (LAPACK) in the dofs left free by
 // Gamma_u, and the one point that satisfies every KKT condition (A x <= g,
 // multipliers >= 0) is the reference. Asserted: the program's x equals it to
-// 1e-10 relative, and so do the active sets.
+// 1e-10 relative, and so do the active sets. Done for node-to-segment rows
+// (qp_scene.prm) and for mortar rows (qp_scene_mortar.prm).
 
 #include <knee_contact/problem.h>
 
@@ -13,132 +14,148 @@
 
 #include <iomanip>
 #include <iostream>
+#include <string>
 
 using namespace dealii;
 using namespace knee_contact;
 
+namespace
+{
+  bool
+  check(const std::string &scene)
+  {
+    std::cout << "scene " << scene << std::endl;
+    ContactProblem problem(SOURCE_DIR "/" + scene);
+    const int      status = problem.run();
+
+    const auto        &K     = problem.matrix();
+    const auto        &f     = problem.rhs();
+    const auto        &base  = problem.base_constraints();
+    const auto        &pairs = problem.pairs();
+    const unsigned int n     = K.m();
+
+    // x = C0 z + g0 over the dofs free of Gamma_u.
+    std::vector<unsigned int> free_index(n, numbers::invalid_unsigned_int);
+    unsigned int              n_free = 0;
+    for (unsigned int i = 0; i < n; ++i)
+      if (!base.is_constrained(i))
+        free_index[i] = n_free++;
+    FullMatrix<double> C0(n, n_free), Kfull(n, n);
+    Vector<double>     g0(n);
+    for (unsigned int i = 0; i < n; ++i)
+      if (free_index[i] != numbers::invalid_unsigned_int)
+        C0(i, free_index[i]) = 1;
+      else
+        {
+          g0(i) = base.get_inhomogeneity(i);
+          for (const auto &[j, c] : *base.get_constraint_entries(i))
+            C0(i, free_index[j]) = c;
+        }
+    Kfull.copy_from(K);
+    FullMatrix<double> KC(n, n_free), H(n_free, n_free);
+    Kfull.mmult(KC, C0);
+    C0.Tmmult(H, KC);
+    Vector<double> Kg(n), fmKg(f), b(n_free);
+    Kfull.vmult(Kg, g0);
+    fmKg -= Kg;
+    C0.Tvmult(b, fmKg);
+
+    const unsigned int M = pairs.size();
+    FullMatrix<double> A(M, n_free);
+    Vector<double>     c(M);
+    for (unsigned int p = 0; p < M; ++p)
+      {
+        c(p) = pairs[p].gap;
+        for (const auto &[dof, a] : pairs[p].row)
+          {
+            c(p) -= a * g0(dof);
+            for (unsigned int j = 0; j < n_free; ++j)
+              A(p, j) += a * C0(dof, j);
+          }
+      }
+
+    unsigned int   n_kkt_points = 0;
+    Vector<double> reference;
+    unsigned int   reference_set = 0;
+    double         scale         = 1e-300;
+    for (unsigned int p = 0; p < n_free; ++p)
+      scale = std::max(scale, std::abs(b(p)));
+    for (unsigned int set = 0; set < (1u << M); ++set)
+      {
+        std::vector<unsigned int> S;
+        for (unsigned int p = 0; p < M; ++p)
+          if (set & (1u << p))
+            S.push_back(p);
+        const unsigned int       m = S.size();
+        LAPACKFullMatrix<double> kkt(n_free + m, n_free + m);
+        Vector<double>           rhs(n_free + m);
+        for (unsigned int i = 0; i < n_free; ++i)
+          {
+            rhs(i) = b(i);
+            for (unsigned int j = 0; j < n_free; ++j)
+              kkt(i, j) = H(i, j);
+          }
+        for (unsigned int k = 0; k < m; ++k)
+          {
+            rhs(n_free + k) = c(S[k]);
+            for (unsigned int j = 0; j < n_free; ++j)
+              kkt(n_free + k, j) = kkt(j, n_free + k) = A(S[k], j);
+          }
+        kkt.compute_lu_factorization();
+        kkt.solve(rhs);
+        Vector<double> z(n_free), Az(M);
+        for (unsigned int i = 0; i < n_free; ++i)
+          z(i) = rhs(i);
+        A.vmult(Az, z);
+        bool kkt_holds = true;
+        for (unsigned int p = 0; p < M; ++p)
+          kkt_holds = kkt_holds && Az(p) - c(p) <= 1e-12 * z.linfty_norm();
+        for (unsigned int k = 0; k < m; ++k)
+          kkt_holds = kkt_holds && rhs(n_free + k) >= -1e-12 * scale;
+        if (kkt_holds)
+          {
+            ++n_kkt_points;
+            reference.reinit(n);
+            C0.vmult(reference, z);
+            reference += g0;
+            reference_set = set;
+          }
+      }
+
+    Vector<double> difference(problem.solution());
+    difference -= reference;
+    const double error    = difference.linfty_norm() / reference.linfty_norm();
+    unsigned int pdas_set = 0;
+    for (unsigned int p = 0; p < M; ++p)
+      if (problem.contact().active[p])
+        pdas_set |= 1u << p;
+
+    // The energy a(x,x) of the enumerated solution: the reference that
+    // prm/hard/partial_closure.prm (the same scene) asserts.
+    Vector<double> Kx(n);
+    K.vmult(Kx, reference);
+    std::cout << "energy a(x,x) of the enumerated solution [J/m] "
+              << std::setprecision(10) << (reference * Kx) << std::endl;
+    std::cout << "pairs " << M << ", free dofs " << n_free
+              << ", active sets satisfying KKT: " << n_kkt_points << std::endl;
+    std::cout << "active set (bit p = pair p) enumeration " << reference_set
+              << ", active-set loop " << pdas_set << std::endl;
+    const bool pass = n_kkt_points == 1 && pdas_set == reference_set &&
+                      error <= 1e-10 && status == 0;
+    std::cout << "check relative difference of x to the enumerated QP "
+                 "solution <= 1e-10: "
+              << (pass ? "PASS" : "FAIL") << std::endl;
+    return pass;
+  }
+} // namespace
+
+
+
 int
 main()
 {
-  ContactProblem problem(SOURCE_DIR "/qp_scene.prm");
-  const int      status = problem.run();
-
-  const auto        &K     = problem.matrix();
-  const auto        &f     = problem.rhs();
-  const auto        &base  = problem.base_constraints();
-  const auto        &pairs = problem.pairs();
-  const unsigned int n     = K.m();
-
-  // x = C0 z + g0 over the dofs free of Gamma_u.
-  std::vector<unsigned int> free_index(n, numbers::invalid_unsigned_int);
-  unsigned int              n_free = 0;
-  for (unsigned int i = 0; i < n; ++i)
-    if (!base.is_constrained(i))
-      free_index[i] = n_free++;
-  FullMatrix<double> C0(n, n_free), Kfull(n, n);
-  Vector<double>     g0(n);
-  for (unsigned int i = 0; i < n; ++i)
-    if (free_index[i] != numbers::invalid_unsigned_int)
-      C0(i, free_index[i]) = 1;
-    else
-      {
-        g0(i) = base.get_inhomogeneity(i);
-        for (const auto &[j, c] : *base.get_constraint_entries(i))
-          C0(i, free_index[j]) = c;
-      }
-  Kfull.copy_from(K);
-  FullMatrix<double> KC(n, n_free), H(n_free, n_free);
-  Kfull.mmult(KC, C0);
-  C0.Tmmult(H, KC);
-  Vector<double> Kg(n), fmKg(f), b(n_free);
-  Kfull.vmult(Kg, g0);
-  fmKg -= Kg;
-  C0.Tvmult(b, fmKg);
-
-  const unsigned int M = pairs.size();
-  FullMatrix<double> A(M, n_free);
-  Vector<double>     c(M);
-  for (unsigned int p = 0; p < M; ++p)
-    {
-      c(p) = pairs[p].gap;
-      for (const auto &[dof, a] : pairs[p].row)
-        {
-          c(p) -= a * g0(dof);
-          for (unsigned int j = 0; j < n_free; ++j)
-            A(p, j) += a * C0(dof, j);
-        }
-    }
-
-  unsigned int   n_kkt_points = 0;
-  Vector<double> reference;
-  unsigned int   reference_set = 0;
-  double         scale         = 1e-300;
-  for (unsigned int p = 0; p < n_free; ++p)
-    scale = std::max(scale, std::abs(b(p)));
-  for (unsigned int set = 0; set < (1u << M); ++set)
-    {
-      std::vector<unsigned int> S;
-      for (unsigned int p = 0; p < M; ++p)
-        if (set & (1u << p))
-          S.push_back(p);
-      const unsigned int       m = S.size();
-      LAPACKFullMatrix<double> kkt(n_free + m, n_free + m);
-      Vector<double>           rhs(n_free + m);
-      for (unsigned int i = 0; i < n_free; ++i)
-        {
-          rhs(i) = b(i);
-          for (unsigned int j = 0; j < n_free; ++j)
-            kkt(i, j) = H(i, j);
-        }
-      for (unsigned int k = 0; k < m; ++k)
-        {
-          rhs(n_free + k) = c(S[k]);
-          for (unsigned int j = 0; j < n_free; ++j)
-            kkt(n_free + k, j) = kkt(j, n_free + k) = A(S[k], j);
-        }
-      kkt.compute_lu_factorization();
-      kkt.solve(rhs);
-      Vector<double> z(n_free), Az(M);
-      for (unsigned int i = 0; i < n_free; ++i)
-        z(i) = rhs(i);
-      A.vmult(Az, z);
-      bool kkt_holds = true;
-      for (unsigned int p = 0; p < M; ++p)
-        kkt_holds = kkt_holds && Az(p) - c(p) <= 1e-12 * z.linfty_norm();
-      for (unsigned int k = 0; k < m; ++k)
-        kkt_holds = kkt_holds && rhs(n_free + k) >= -1e-12 * scale;
-      if (kkt_holds)
-        {
-          ++n_kkt_points;
-          reference.reinit(n);
-          C0.vmult(reference, z);
-          reference += g0;
-          reference_set = set;
-        }
-    }
-
-  Vector<double> difference(problem.solution());
-  difference -= reference;
-  const double error    = difference.linfty_norm() / reference.linfty_norm();
-  unsigned int pdas_set = 0;
-  for (unsigned int p = 0; p < M; ++p)
-    if (problem.contact().active[p])
-      pdas_set |= 1u << p;
-
-  // The energy a(x,x) of the enumerated solution: the reference that
-  // prm/hard/partial_closure.prm (the same scene) asserts.
-  Vector<double> Kx(n);
-  K.vmult(Kx, reference);
-  std::cout << "energy a(x,x) of the enumerated solution [J/m] "
-            << std::setprecision(10) << (reference * Kx) << std::endl;
-  std::cout << "pairs " << M << ", free dofs " << n_free
-            << ", active sets satisfying KKT: " << n_kkt_points << std::endl;
-  std::cout << "active set (bit p = pair p) enumeration " << reference_set
-            << ", active-set loop " << pdas_set << std::endl;
-  const bool pass = n_kkt_points == 1 && pdas_set == reference_set &&
-                    error <= 1e-10 && status == 0;
-  std::cout << "check relative difference of x to the enumerated QP "
-               "solution <= 1e-10: "
-            << (pass ? "PASS" : "FAIL") << std::endl;
-  return pass ? 0 : 1;
+  // Node-to-segment rows, then mortar rows of the same scene.
+  const bool node_to_segment = check("qp_scene.prm");
+  const bool mortar          = check("qp_scene_mortar.prm");
+  return node_to_segment && mortar ? 0 : 1;
 }
