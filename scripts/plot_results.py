@@ -104,6 +104,8 @@ def contact_pressure(folder):
         s = np.array([float(r["arc_length"]) for r in rows]) * 1e3
         p = np.array([float(r["pressure"]) for r in rows]) / 1e6
         name = os.path.basename(path)[len("contact_"):-len(".csv")]
+        if rows and "discretisation" in rows[0]:
+            name += " (%s)" % rows[0]["discretisation"]
         axes.plot(s, p, ".-", label=name)
     axes.set_xlabel("arc length along the slave side [mm]")
     axes.set_ylabel("contact pressure [MPa]")

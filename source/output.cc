@@ -375,7 +375,10 @@ namespace knee_contact
         const std::string name = csv_file_name(interfaces.interfaces()[i].name);
         write_checked(
           staging(name), output_folder + "/" + name, [&](std::ostream &out) {
-            out << "arc_length,x,y,n_x,n_y,gap,jump,pressure,active\n"
+            // The discretisation in every row, so that a CSV read on its
+            // own says how its pressure was computed.
+            out << "arc_length,x,y,n_x,n_y,gap,jump,pressure,active,"
+                   "discretisation\n"
                 << std::setprecision(10);
             double s = 0;
             for (unsigned int k = 0; k < order.size(); ++k)
@@ -387,7 +390,8 @@ namespace knee_contact
                     << ',' << pair.normal[0] << ',' << pair.normal[1] << ','
                     << pair.gap << ',' << pair.jump(solution) << ','
                     << results.pressure[order[k]] << ','
-                    << (contact.active[order[k]] ? 1 : 0) << '\n';
+                    << (contact.active[order[k]] ? 1 : 0) << ','
+                    << results.interfaces[i].discretisation << '\n';
               }
           });
       }
@@ -424,6 +428,7 @@ namespace knee_contact
         n_pairs += i.n_pairs;
         n_active += i.n_active;
         summary["contact_interfaces"][i.name] = {
+          {"discretisation", i.discretisation},
           {"n_pairs", i.n_pairs},
           {"n_active", i.n_active},
           {"force", i.force},

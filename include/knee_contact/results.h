@@ -22,7 +22,9 @@ namespace knee_contact
 
   struct InterfaceResult
   {
-    std::string  name;
+    std::string name;
+    /** The contact discretisation: mortar, node-to-segment, node-to-node. */
+    std::string  discretisation;
     unsigned int n_pairs  = 0;
     unsigned int n_active = 0;
     /** Sum of lambda_p [N/m]: the normal contact force per unit thickness. */
