@@ -122,10 +122,11 @@ namespace knee_contact
         interface.master_id = static_cast<types::boundary_id>(
           prm.get_integer("Master boundary id"));
         const std::string pairing = prm.get("Pairing");
-        interface.pairing = pairing == "mortar"          ? Pairing::mortar :
-                            pairing == "node-to-segment" ? Pairing::node_to_segment :
-                                                           Pairing::node_to_node;
-        interface.maximum_gap  = prm.get_double("Maximum gap");
+        interface.pairing         = pairing == "mortar" ? Pairing::mortar
+                                    : pairing == "node-to-segment"
+                                      ? Pairing::node_to_segment
+                                      : Pairing::node_to_node;
+        interface.maximum_gap     = prm.get_double("Maximum gap");
         const std::string where =
           "Contact/Interface " + std::to_string(i) + ": ";
         AssertThrow(interface.slave_id != interface.master_id,
@@ -376,15 +377,14 @@ namespace knee_contact
       {
         const ContactInterface &interface = list[i];
         const ContactSides      sides = collect_sides(dof_handler, interface);
-        const std::string       where = "Contact/Interface " +
-                                  std::to_string(i) + " ('" + interface.name +
-                                  "'): ";
+        const std::string where = "Contact/Interface " + std::to_string(i) +
+                                  " ('" + interface.name + "'): ";
         AssertThrow(!sides.slaves.empty() && !sides.master_faces.empty(),
                     ExcMessage(where + "a side has no faces"));
         std::vector<ContactPair> rows =
-          interface.pairing == Pairing::mortar ?
-            mortar_rows(sides, interface, i, where) :
-            node_to_segment_rows(sides, interface, i, where);
+          interface.pairing == Pairing::mortar
+            ? mortar_rows(sides, interface, i, where)
+            : node_to_segment_rows(sides, interface, i, where);
 
         for (ContactPair &pair : rows)
           {

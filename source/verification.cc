@@ -49,6 +49,16 @@ namespace knee_contact
                       "0",
                       Patterns::Double(0),
                       "The same for the energy norm error.");
+    prm.declare_entry("Maximum L2 error",
+                      "0",
+                      Patterns::Double(0),
+                      "With an exact displacement: the largest allowed "
+                      "relative L2 error on the last mesh; 0: no check.");
+    prm.declare_entry("Minimum pressure rate",
+                      "0",
+                      Patterns::Double(0),
+                      "The same for the L2 error of the contact pressure "
+                      "over the slave sides against Exact contact pressure.");
     prm.declare_entry("Check KKT",
                       "true",
                       Patterns::Bool(),
@@ -131,6 +141,8 @@ namespace knee_contact
     tolerance          = prm.get_double("Tolerance");
     min_l2_rate        = prm.get_double("Minimum L2 rate");
     min_energy_rate    = prm.get_double("Minimum energy rate");
+    min_pressure_rate  = prm.get_double("Minimum pressure rate");
+    max_l2_error       = prm.get_double("Maximum L2 error");
     check_kkt          = prm.get_bool("Check KKT");
     if (!prm.get("Reference peak pressure").empty())
       peak_pressure =
@@ -428,6 +440,16 @@ namespace knee_contact
              min_rate(&Errors::energy_relative),
              ">=",
              min_energy_rate);
+    if (max_l2_error > 0)
+      report("relative L2 error on the last mesh",
+             last.l2_relative,
+             "<=",
+             max_l2_error);
+    if (min_pressure_rate > 0)
+      report("smallest contact pressure L2 rate after the first refinement",
+             min_rate(&Errors::pressure_l2_relative),
+             ">=",
+             min_pressure_rate);
 
     if (has_contact && check_kkt)
       {
