@@ -5,8 +5,10 @@
 // Mesh sizes: lc_fine in the contact zone, lc_coarse elsewhere; gmsh's
 // subdivision into quadrilaterals halves both.
 Geometry.AutoCoherence = 0;
-R = 1;
 // Defaults; "gmsh -setnumber lc_fine 0.005" (Mesh/Gmsh arguments) overrides.
+If (!Exists(R))
+  R = 1;
+EndIf
 If (!Exists(lc_fine))
   lc_fine = 0.01;
 EndIf
@@ -39,7 +41,7 @@ Plane Surface(2) = {2};
 Field[1] = Box;
 Field[1].VIn = lc_fine;
 Field[1].VOut = lc_coarse;
-Field[1].XMin = -0.1;
+Field[1].XMin = -0.1 * R;
 Field[1].XMax = 0.25 * R;
 Field[1].YMin = -0.05 * R;
 Field[1].YMax = 0.05 * R;
