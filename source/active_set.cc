@@ -13,6 +13,8 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <stdexcept>
+#include <string>
 
 namespace knee_contact
 {
@@ -187,7 +189,8 @@ namespace knee_contact
           if (entry.first != pair.eliminated)
             one_level[pair.eliminated].insert(entry.first);
     std::map<types::global_dof_index, std::vector<types::global_dof_index>>
-      expansion;
+                                      expansion;
+    std::set<types::global_dof_index> in_progress;
     const std::function<const std::vector<types::global_dof_index> &(
       types::global_dof_index)>
       closure = [&](const types::global_dof_index i)
@@ -195,6 +198,12 @@ namespace knee_contact
       const auto known = expansion.find(i);
       if (known != expansion.end())
         return known->second;
+      // Lines that refer to each other in a cycle cannot be constraints; the
+      // elimination in make_pairs() is meant to prevent it.
+      if (!in_progress.insert(i).second)
+        throw std::logic_error("the contact rows eliminate dofs that refer "
+                               "to each other in a cycle (dof " +
+                               std::to_string(i) + ")");
       std::set<types::global_dof_index> dofs = {i};
       const auto                        it   = one_level.find(i);
       if (it != one_level.end())

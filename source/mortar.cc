@@ -15,7 +15,8 @@
 // integrated over the pieces of the slave faces that the master faces'
 // orthogonal projections cut (on each piece every integrand is a product
 // of two affine functions, so 2-point Gauss is exact: no quadrature across
-// kinks). Where a slave face is fully covered D is diagonal. Each row is
+// kinks). Where a slave face is fully covered D is diagonal (elsewhere it
+// is lumped, see below). Each row is
 // divided by its weight W_j = sum_i D_ji = int psi_j, so that it reads like
 // a node-to-segment row (own normal displacement minus a weighted mean of
 // the master's) and the multiplier divided by ContactPair::length = W_j is
@@ -212,15 +213,15 @@ namespace knee_contact
         pair.master_point = vertex.position + pair.gap * n;
         pair.length       = weight;
         pair.slave_dofs   = vertex.dofs;
-        // The vertex's own dofs first (the elimination prefers them).
+        // D lumped onto the diagonal: where the master covers a slave face
+        // only in part, int psi_j phi_i (i != j) is not zero, and keeping it
+        // would couple neighbouring slave vertices' rows, whose eliminated
+        // dofs would then refer to each other (a cycle no set of constraint
+        // lines can hold). Lumping keeps sum_i D_ji = W_j, so rigid
+        // translations stay free of the condition; it changes nothing where
+        // faces are fully covered (D is diagonal there).
         for (unsigned int d = 0; d < 2; ++d)
-          pair.row.emplace_back(vertex.dofs[d],
-                                row.slave.at(key) / weight * n[d]);
-        for (const auto &[other, D] : row.slave)
-          if (other != key && D != 0)
-            for (unsigned int d = 0; d < 2; ++d)
-              pair.row.emplace_back(sides.slaves.at(other).dofs[d],
-                                    D / weight * n[d]);
+          pair.row.emplace_back(vertex.dofs[d], n[d]);
         for (const auto &[dofs, M] : row.master)
           if (M != 0)
             for (unsigned int d = 0; d < 2; ++d)
