@@ -486,12 +486,12 @@ namespace knee_contact
     // A reaction component that is zero by physics comes out as round-off
     // of the force scale (1e-8 N/m beside 1e6 N/m); printed as it is, it
     // would make every comparison of this table with an earlier run fail on
-    // noise. Components below 1e-12 of the largest force are shown as 0.
+    // noise. Components below 1e-10 of the largest force are shown as 0.
     double force_scale = results.applied_load.norm();
     for (const auto &[id, reaction] : results.reactions)
       force_scale = std::max(force_scale, reaction.norm());
     const auto shown = [force_scale](const double f) {
-      return std::abs(f) <= 1e-12 * force_scale ? 0. : f;
+      return std::abs(f) <= 1e-10 * force_scale ? 0. : f;
     };
     for (const auto &[id, reaction] : results.reactions)
       out << "  reaction at boundary id " << std::setw(3) << id << " [N/m] ("

@@ -59,6 +59,10 @@ EXEMPT = [
      "4e-5: below the test mesh's error against the overkill"),
     ("knee_frontal.prm", r"^nu: Materials/Material 0:|Material [13]:",
      "as tests/accuracy/knee.prm"),
+    ("hertz_two_materials.prm", r"^nu: Materials/Material 0:",
+     "1 % of the cylinder's nu = 0.25 changes its 1 - nu^2 by 0.13 % and "
+     "E* by 0.05 %, the energy by about 5e-4: at the test mesh's own error "
+     "against the overkill (5.4e-4)"),
     ("knee_small.prm", r".",
      "coarse-mesh regression scene (statics asserted); "
      "tests/accuracy/knee.prm verifies the model against its overkill"),
