@@ -121,12 +121,13 @@ namespace knee_contact
           static_cast<types::boundary_id>(prm.get_integer("Slave boundary id"));
         interface.master_id = static_cast<types::boundary_id>(
           prm.get_integer("Master boundary id"));
-        const std::string pairing = prm.get("Pairing");
-        interface.pairing         = pairing == "mortar" ? Pairing::mortar
-                                    : pairing == "node-to-segment"
-                                      ? Pairing::node_to_segment
-                                      : Pairing::node_to_node;
-        interface.maximum_gap     = prm.get_double("Maximum gap");
+        // The Selection pattern admits exactly the names pairing_name()
+        // gives.
+        for (const Pairing p :
+             {Pairing::mortar, Pairing::node_to_segment, Pairing::node_to_node})
+          if (prm.get("Pairing") == pairing_name(p))
+            interface.pairing = p;
+        interface.maximum_gap = prm.get_double("Maximum gap");
         const std::string where =
           "Contact/Interface " + std::to_string(i) + ": ";
         AssertThrow(interface.slave_id != interface.master_id,
@@ -291,7 +292,7 @@ namespace knee_contact
     std::vector<ContactPair> pairs;
     for (const auto &[vertex, slave] : sides.slaves)
       {
-        const Tensor<1, 2> n   = slave.normal / slave.normal.norm();
+        const Tensor<1, 2> n   = slave.unit_normal();
         const double       tol = 1e-8 * sides.min_length;
         // Node-to-segment: x + s n = p0 + xi (p1 - p0), the closest
         // master face facing the slave (n_master . n < 0) along n.

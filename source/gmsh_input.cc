@@ -111,6 +111,28 @@ namespace knee_contact
           return std::stoll(token);
         }
 
+        // A node tag of $Nodes, which must not repeat.
+        void
+        add_node(std::unordered_set<long long> &nodes,
+                 const std::string             &token) const
+        {
+          if (!nodes.insert(tag(token, "node tag")).second)
+            fail("node tag " + token + " appears twice");
+        }
+
+        // The node tags t[first], ... of element t[0]: each must be in
+        // $Nodes.
+        void
+        check_element_nodes(const std::unordered_set<long long> &nodes,
+                            const std::vector<std::string>      &t,
+                            const std::size_t                    first) const
+        {
+          for (std::size_t k = first; k < t.size(); ++k)
+            if (nodes.count(tag(t[k], "node tag")) == 0)
+              fail("element " + t[0] + " refers to node " + t[k] +
+                   ", which is not in $Nodes");
+        }
+
         void
         coordinate(const std::string &token) const
         {
@@ -190,8 +212,7 @@ namespace knee_contact
                 for (unsigned long long i = 0; i < n; ++i)
                   {
                     t = reader.expect(4, 4, "a node 'tag x y z'");
-                    if (!nodes.insert(reader.tag(t[0], "node tag")).second)
-                      reader.fail("node tag " + t[0] + " appears twice");
+                    reader.add_node(nodes, t[0]);
                     for (unsigned int d = 1; d < 4; ++d)
                       reader.coordinate(t[d]);
                   }
@@ -216,17 +237,16 @@ namespace knee_contact
                       reader.fail("element " + t[0] + " has " +
                                   std::to_string(t.size()) +
                                   " fields, not 3 + tags + nodes");
-                    for (std::size_t k = 3; k < 3 + n_tags; ++k)
+                    const std::size_t first_node =
+                      3 + static_cast<std::size_t>(n_tags);
+                    for (std::size_t k = 3; k < first_node; ++k)
                       if (reader.tag(t[k], "element tag") < 0)
                         reader.fail("element " + t[0] + " has a negative tag");
                     if ((n_v == 3 || n_v == 4) && (n_tags == 0 || t[3] == "0"))
                       reader.fail("cell " + t[0] +
                                   " has no physical group, so no material id "
                                   "(give every surface a Physical Surface)");
-                    for (std::size_t k = 3 + n_tags; k < t.size(); ++k)
-                      if (nodes.count(reader.tag(t[k], "node tag")) == 0)
-                        reader.fail("element " + t[0] + " refers to node " +
-                                    t[k] + ", which is not in $Nodes");
+                    reader.check_element_nodes(nodes, t, first_node);
                   }
                 reader.end_of("Elements");
                 have_elements = true;
@@ -303,12 +323,8 @@ namespace knee_contact
                     const auto n = reader.count(t[3], "node count of a block");
                     const bool parametric = t[2] != "0";
                     for (unsigned long long i = 0; i < n; ++i)
-                      if (!nodes
-                             .insert(
-                               reader.tag(reader.expect(1, 1, "a node tag")[0],
-                                          "node tag"))
-                             .second)
-                        reader.fail("a node tag appears twice");
+                      reader.add_node(nodes,
+                                      reader.expect(1, 1, "a node tag")[0]);
                     for (unsigned long long i = 0; i < n; ++i)
                       {
                         t = reader.expect(3,
@@ -350,10 +366,7 @@ namespace knee_contact
                         t = reader.expect(1 + n_v,
                                           1 + n_v,
                                           "an element 'tag nodes...'");
-                        for (std::size_t k = 1; k < t.size(); ++k)
-                          if (nodes.count(reader.tag(t[k], "node tag")) == 0)
-                            reader.fail("element " + t[0] + " refers to node " +
-                                        t[k] + ", which is not in $Nodes");
+                        reader.check_element_nodes(nodes, t, 1);
                       }
                   }
                 reader.end_of("Elements");

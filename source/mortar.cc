@@ -34,9 +34,11 @@ namespace knee_contact
 {
   namespace
   {
+    // One slave vertex's row while it is integrated: its weight
+    // W_j = int psi_j (= sum_i D_ji, as sum_i phi_i = 1), M_j. and g~_j.
     struct Accumulator
     {
-      std::map<unsigned int, double>                           slave;
+      double                                                   weight = 0;
       std::map<std::array<types::global_dof_index, 2>, double> master;
       double                                                   gap = 0;
     };
@@ -97,6 +99,16 @@ namespace knee_contact
         {
           double                    lo, hi, xi_c, xi_d, distance;
           const ContactSides::Face *master;
+
+          // The point of the master face that projects onto slave
+          // parameter xi.
+          Point<2>
+          master_point(const double xi) const
+          {
+            const double eta = (xi - xi_c) / (xi_d - xi_c);
+            return master->vertices[0] +
+                   eta * (master->vertices[1] - master->vertices[0]);
+          }
         };
         std::vector<Candidate> candidates;
         for (const ContactSides::Face &master : sides.master_faces)
@@ -111,15 +123,15 @@ namespace knee_contact
             const double hi = std::min(1., std::max(xi_c, xi_d));
             if (hi - lo < 1e-12)
               continue;
-            const double   xi  = 0.5 * (lo + hi);
-            const double   eta = (xi - xi_c) / (xi_d - xi_c);
-            const Point<2> xm  = master.vertices[0] +
-                                eta * (master.vertices[1] - master.vertices[0]);
-            const double s = (xm - (xa + xi * e)) * slave.normal;
+            Candidate    c  = {lo, hi, xi_c, xi_d, 0, &master};
+            const double xi = 0.5 * (lo + hi);
+            const double s =
+              (c.master_point(xi) - (xa + xi * e)) * slave.normal;
             if (s < -L ||
                 (interface.maximum_gap > 0 && s > interface.maximum_gap))
               continue;
-            candidates.push_back({lo, hi, xi_c, xi_d, std::abs(s), &master});
+            c.distance = std::abs(s);
+            candidates.push_back(c);
           }
         std::sort(candidates.begin(),
                   candidates.end(),
@@ -141,12 +153,8 @@ namespace knee_contact
                 // mortar condition, not an overlap.)
                 for (const double xi : {p0, p1})
                   {
-                    const double   eta = (xi - c.xi_c) / (c.xi_d - c.xi_c);
-                    const Point<2> xs  = xa + xi * e;
-                    const Point<2> xm =
-                      c.master->vertices[0] +
-                      eta * (c.master->vertices[1] - c.master->vertices[0]);
-                    const double gap = (xm - xs) * slave.normal;
+                    const Point<2> xs = xa + xi * e;
+                    const double gap = (c.master_point(xi) - xs) * slave.normal;
                     AssertThrow(gap >= -overlap_allowed,
                                 ExcMessage(
                                   where + "the slave side at (" +
@@ -163,27 +171,22 @@ namespace knee_contact
                     const double xi  = 0.5 * (p0 + p1) + 0.5 * (p1 - p0) * q;
                     const double w   = 0.5 * (p1 - p0) * L;
                     const double eta = (xi - c.xi_c) / (c.xi_d - c.xi_c);
-                    const std::array<double, 2> phi = {{1 - xi, xi}};
                     const std::array<double, 2> psi = {
                       {2 - 3 * xi, 3 * xi - 1}};
                     const std::array<double, 2> phi_master = {{1 - eta, eta}};
-                    const Point<2>              xs         = xa + xi * e;
-                    const Point<2>              xm =
-                      c.master->vertices[0] +
-                      eta * (c.master->vertices[1] - c.master->vertices[0]);
+                    const Tensor<1, 2>          x_jump =
+                      c.master_point(xi) - (xa + xi * e);
                     for (unsigned int j = 0; j < 2; ++j)
                       {
-                        const unsigned int  key   = slave.vertex_keys[j];
-                        const Tensor<1, 2> &n_sum = sides.slaves.at(key).normal;
-                        const Tensor<1, 2>  n     = n_sum / n_sum.norm();
-                        Accumulator        &row   = rows[key];
-                        for (unsigned int i = 0; i < 2; ++i)
-                          row.slave[slave.vertex_keys[i]] +=
-                            w * psi[j] * phi[i];
+                        const unsigned int key = slave.vertex_keys[j];
+                        Accumulator       &row = rows[key];
+                        row.weight += w * psi[j];
                         for (unsigned int k = 0; k < 2; ++k)
                           row.master[c.master->dofs[k]] +=
                             w * psi[j] * phi_master[k];
-                        row.gap += w * psi[j] * ((xm - xs) * n);
+                        row.gap +=
+                          w * psi[j] *
+                          (x_jump * sides.slaves.at(key).unit_normal());
                       }
                   }
               }
@@ -195,15 +198,13 @@ namespace knee_contact
     for (const auto &[key, row] : rows)
       {
         const ContactSides::SlaveVertex &vertex = sides.slaves.at(key);
-        double                           weight = 0;
-        for (const auto &entry : row.slave)
-          weight += entry.second;
+        const double                     weight = row.weight;
         // A vertex whose faces the master covers for less than a quarter of
         // its weight (at an interface end that overhangs the master) gets
         // no row: int psi_j over a small end piece can be tiny or negative.
         if (weight < 0.25 * vertex.length)
           continue;
-        const Tensor<1, 2> n   = vertex.normal / vertex.normal.norm();
+        const Tensor<1, 2> n   = vertex.unit_normal();
         const double       gap = row.gap / weight;
         ContactPair        pair;
         pair.interface    = interface_index;
@@ -213,13 +214,14 @@ namespace knee_contact
         pair.master_point = vertex.position + pair.gap * n;
         pair.length       = weight;
         pair.slave_dofs   = vertex.dofs;
-        // D lumped onto the diagonal: where the master covers a slave face
-        // only in part, int psi_j phi_i (i != j) is not zero, and keeping it
-        // would couple neighbouring slave vertices' rows, whose eliminated
-        // dofs would then refer to each other (a cycle no set of constraint
-        // lines can hold). Lumping keeps sum_i D_ji = W_j, so rigid
-        // translations stay free of the condition; it changes nothing where
-        // faces are fully covered (D is diagonal there).
+        // D lumped onto the diagonal (D_jj = W_j, so the row's own
+        // coefficient is n_j): where the master covers a slave face only in
+        // part, int psi_j phi_i (i != j) is not zero, and keeping it would
+        // couple neighbouring slave vertices' rows, whose eliminated dofs
+        // would then refer to each other (a cycle no set of constraint lines
+        // can hold). Lumping keeps sum_i D_ji = W_j, so rigid translations
+        // stay free of the condition; it changes nothing where faces are
+        // fully covered (D is diagonal there).
         for (unsigned int d = 0; d < 2; ++d)
           pair.row.emplace_back(vertex.dofs[d], n[d]);
         for (const auto &[dofs, M] : row.master)

@@ -32,6 +32,12 @@ namespace knee_contact
       Tensor<1, 2>                           normal;
       double                                 length = 0;
       std::array<types::global_dof_index, 2> dofs;
+
+      Tensor<1, 2>
+      unit_normal() const
+      {
+        return normal / normal.norm();
+      }
     };
 
     struct Face
