@@ -16,7 +16,7 @@
 //   xi = (x_s - x_a) / (x_b - x_a): row = n . (u_s - (1 - xi) u_a - xi u_b),
 //   gap 0, the vertex's share of slave length (0.25 at the ends, 0.5 inside).
 // The program's DoFHandler is used only to find the dof index of a vertex of
-// a cell (cells matched by centre, vertices by position).
+// a cell (cells matched by centre, vertices by position: dof_at()).
 // Asserted: matrix, load and rows equal to 1e-12 relative to their largest
 // entries, the same pairs, the same gaps and lengths; and the mortar rows of
 // the same scene (see below).
@@ -28,6 +28,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdlib>
 #include <iostream>
 
 using namespace dealii;
@@ -82,6 +83,25 @@ namespace
     return K;
   }
 
+  // The dof of component d at the vertex p of the cell whose centre is c:
+  // the program's DoFHandler is used for its numbering only.
+  types::global_dof_index
+  dof_at(const DoFHandler<2> &dofs,
+         const Point<2>      &c,
+         const Point<2>      &p,
+         const unsigned int   d)
+  {
+    for (const auto &cell : dofs.active_cell_iterators())
+      if (cell->center().distance(c) < 1e-12)
+        for (const unsigned int v : cell->vertex_indices())
+          if (cell->vertex(v).distance(p) < 1e-12)
+            return cell->vertex_dof_index(v, d);
+    std::cerr << "no vertex " << p << " in the cell at " << c << std::endl;
+    std::exit(1);
+  }
+
+
+
   double
   max_abs(const FullMatrix<double> &M)
   {
@@ -102,16 +122,6 @@ main()
   const DoFHandler<2> &dofs = problem.dof_handler_of();
   const unsigned int   n    = dofs.n_dofs();
 
-  // The dof of component d at the vertex p of the cell whose centre is c.
-  const auto dof_at = [&](const Point<2> &c, const Point<2> &p, unsigned d) {
-    for (const auto &cell : dofs.active_cell_iterators())
-      if (cell->center().distance(c) < 1e-12)
-        for (const unsigned int v : cell->vertex_indices())
-          if (cell->vertex(v).distance(p) < 1e-12)
-            return cell->vertex_dof_index(v, d);
-    std::cerr << "no vertex " << p << " in the cell at " << c << std::endl;
-    std::exit(1);
-  };
 
   const std::array<Block, 2> blocks = {
     {{0, 0, 2, 1, 3, 2, 1e9, 0.3}, {0, 1, 2, 1.5, 4, 1, 2e9, 0.25}}};
@@ -133,7 +143,7 @@ main()
             std::array<types::global_dof_index, 8> index;
             for (unsigned int a = 0; a < 4; ++a)
               for (unsigned int d = 0; d < 2; ++d)
-                index[2 * a + d] = dof_at(centre, corner[a], d);
+                index[2 * a + d] = dof_at(dofs, centre, corner[a], d);
             for (unsigned int k = 0; k < 8; ++k)
               for (unsigned int l = 0; l < 8; ++l)
                 K(index[k], index[l]) += Ke(k, l);
@@ -161,13 +171,13 @@ main()
       lengths[s]   = (s == 0 || s + 1 == n_slave) ? hs / 2 : hs;
       const Point<2> slave_cell(std::min(s, n_slave - 2) * hs + hs / 2, 1.25);
       // n . u_s with n = (0, -1)
-      rows[s](dof_at(slave_cell, xs, 1)) += -1;
+      rows[s](dof_at(dofs, slave_cell, xs, 1)) += -1;
       const unsigned int m =
         std::min<unsigned int>(std::floor(xs[0] / hm), n_master - 2);
       const double   xi = (xs[0] - m * hm) / hm;
       const Point<2> master_cell(m * hm + hm / 2, 0.75);
-      rows[s](dof_at(master_cell, Point<2>(m * hm, 1), 1)) += (1 - xi);
-      rows[s](dof_at(master_cell, Point<2>((m + 1) * hm, 1), 1)) += xi;
+      rows[s](dof_at(dofs, master_cell, Point<2>(m * hm, 1), 1)) += (1 - xi);
+      rows[s](dof_at(dofs, master_cell, Point<2>((m + 1) * hm, 1), 1)) += xi;
     }
 
   // Compare.
@@ -227,13 +237,7 @@ main()
   pass                             = pass && mortar.run() == 0;
   const DoFHandler<2> &mortar_dofs = mortar.dof_handler_of();
   const auto           mortar_dof  = [&](const Point<2> &c, const Point<2> &p) {
-    for (const auto &cell : mortar_dofs.active_cell_iterators())
-      if (cell->center().distance(c) < 1e-12)
-        for (const unsigned int v : cell->vertex_indices())
-          if (cell->vertex(v).distance(p) < 1e-12)
-            return cell->vertex_dof_index(v, 1);
-    std::cerr << "no vertex " << p << " in the cell at " << c << std::endl;
-    std::exit(1);
+    return dof_at(mortar_dofs, c, p, 1);
   };
   const double hs = 0.5, hm = 2. / 3;
   const auto   hat = [](const double x, const double node, const double h) {

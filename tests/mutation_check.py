@@ -130,7 +130,7 @@ def scale_number(text):
 
 
 def mutants(scene_path):
-    """Yield (kind, description, scene text, extra files) of the scene."""
+    """Yield (kind, description, scene text, extra files by name)."""
     text = open(scene_path).read()
     found = list(entries(text))
     types = {}
@@ -140,24 +140,25 @@ def mutants(scene_path):
     for path, name, value, start, end in found:
         if name == "Young's modulus":
             yield ("E", f"{path}: E x {FACTOR}",
-                   replace_entry(text, start, end, name, scale_number(value)))
+                   replace_entry(text, start, end, name, scale_number(value)),
+                   {})
         elif name == "Poisson's ratio":
             # Near 0.5 the 1 % goes down, so that nu stays admissible.
             factor = FACTOR if float(value) * FACTOR < 0.5 else 2 - FACTOR
             yield ("nu", f"{path}: nu x {factor}",
                    replace_entry(text, start, end, name,
-                                 repr(float(value) * factor)))
+                                 repr(float(value) * factor)), {})
         elif name == "Body force" and not is_zero(value):
             yield ("load", f"{path}: body force x {FACTOR}",
                    replace_entry(text, start, end, name,
-                                 scaled_expression(value)))
+                                 scaled_expression(value)), {})
         elif (name == "Value" and types.get(path, "displacement")
               in ("displacement", "traction", "pressure")
               and not is_zero(value)):
             yield ("load", f"{path}: {types.get(path, 'displacement')} "
                    f"x {FACTOR}",
                    replace_entry(text, start, end, name,
-                                 scaled_expression(value)))
+                                 scaled_expression(value)), {})
     # Geometry: every coordinate x FACTOR.
     geometry = text
     geometry_files = {}
@@ -204,8 +205,7 @@ def absolute_paths(text, scene_dir):
 
 
 def run(program, scene_path, mutant):
-    kind, description, text, *extra = mutant
-    files = extra[0] if extra else {}
+    kind, description, text, files = mutant
     work = tempfile.mkdtemp(prefix="mutant-")
     try:
         text = absolute_paths(text, os.path.dirname(scene_path))
