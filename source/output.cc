@@ -391,7 +391,7 @@ namespace knee_contact
                     << pair.gap << ',' << pair.jump(solution) << ','
                     << results.pressure[order[k]] << ','
                     << (contact.active[order[k]] ? 1 : 0) << ','
-                    << results.interfaces[i].discretisation << '\n';
+                    << pairing_name(results.interfaces[i].pairing) << '\n';
               }
           });
       }
@@ -428,7 +428,7 @@ namespace knee_contact
         n_pairs += i.n_pairs;
         n_active += i.n_active;
         summary["contact_interfaces"][i.name] = {
-          {"discretisation", i.discretisation},
+          {"discretisation", pairing_name(i.pairing)},
           {"n_pairs", i.n_pairs},
           {"n_active", i.n_active},
           {"force", i.force},

@@ -145,9 +145,8 @@ namespace knee_contact
     results.interfaces.resize(interfaces.interfaces().size());
     for (unsigned int i = 0; i < results.interfaces.size(); ++i)
       {
-        results.interfaces[i].name = interfaces.interfaces()[i].name;
-        results.interfaces[i].discretisation =
-          pairing_name(interfaces.interfaces()[i].pairing);
+        results.interfaces[i].name    = interfaces.interfaces()[i].name;
+        results.interfaces[i].pairing = interfaces.interfaces()[i].pairing;
       }
     results.pressure.resize(pairs.size());
     for (unsigned int p = 0; p < pairs.size(); ++p)

@@ -23,8 +23,8 @@ namespace knee_contact
   struct InterfaceResult
   {
     std::string name;
-    /** The contact discretisation: mortar, node-to-segment, node-to-node. */
-    std::string  discretisation;
+    /** The contact discretisation that produced the pressure. */
+    Pairing      pairing  = Pairing::mortar;
     unsigned int n_pairs  = 0;
     unsigned int n_active = 0;
     /** Sum of lambda_p [N/m]: the normal contact force per unit thickness. */
