@@ -8,9 +8,11 @@ cd "$(dirname "$0")"
 # libdeal.ii-dev brings deal.II 9.4 with Trilinos, SuiteSparse (UMFPACK),
 # Boost, muparser and MPI; numdiff, perl and mpiexec serve deal.II's test
 # machinery; gmsh meshes .geo scenes; OpenBLAS makes UMFPACK 5-6x faster than
-# the reference BLAS; nlohmann-json writes summary.json with real numbers.
+# the reference BLAS; nlohmann-json writes summary.json with real numbers;
+# the condensed contact solver calls CHOLMOD (libsuitesparse-dev) and METIS.
 packages="cmake make g++ libdeal.ii-dev numdiff perl openmpi-bin gmsh
-          libopenblas0-pthread nlohmann-json3-dev python3-matplotlib"
+          libopenblas0-pthread nlohmann-json3-dev python3-matplotlib
+          libsuitesparse-dev libmetis-dev"
 missing=""
 for package in $packages; do
   dpkg-query -W -f='${Status}' "$package" 2>/dev/null |

@@ -47,6 +47,15 @@ namespace knee_contact
                       "releasing at most one pair per iteration (the most "
                       "negative lambda) while adding every penetrating pair; "
                       "false: stop with converged = false.");
+    prm.declare_entry("Solver",
+                      "condensed",
+                      Patterns::Selection("condensed|step-41"),
+                      "condensed: factorise once per mesh with the contact "
+                      "unknowns last and run the loop on their Schur "
+                      "complement (about the cost of one linear solve); "
+                      "step-41: condense and factorise the whole system "
+                      "with UMFPACK in every iteration (the first "
+                      "version's path, kept for comparison).");
     prm.leave_subsection();
   }
 
@@ -61,6 +70,8 @@ namespace knee_contact
     c              = prm.get_double("Active set constant") * max_youngs_modulus;
     tolerance      = prm.get_double("Tolerance");
     safeguard      = prm.get_bool("Cycle safeguard");
+    solver         = prm.get("Solver") == "step-41" ? LinearSolver::step41 :
+                                                      LinearSolver::condensed;
     AssertThrow(c > 0, ExcMessage("Contact/Active set constant must be > 0"));
     prm.leave_subsection();
   }
@@ -245,14 +256,69 @@ namespace knee_contact
 
 
 
+  FullContactSystem::FullContactSystem(const SparseMatrix<double>      &matrix,
+                                       const Vector<double>            &rhs,
+                                       const AffineConstraints<double> &base,
+                                       const std::vector<ContactPair>  &pairs)
+    : matrix(matrix)
+    , rhs(rhs)
+    , base(base)
+    , pairs(pairs)
+    , system_matrix(matrix.get_sparsity_pattern())
+    , system_rhs(rhs.size())
+    , x(rhs.size())
+  {}
+
+
+
+  void
+  FullContactSystem::solve(const std::vector<bool> &active,
+                           std::vector<double>     &excess,
+                           std::vector<double>     &lambda)
+  {
+    AffineConstraints<double> constraints;
+    ActiveSetSolver::make_constraints(base, pairs, active, constraints);
+    system_matrix.copy_from(matrix);
+    system_rhs = rhs;
+    constraints.condense(system_matrix, system_rhs);
+    SparseDirectUMFPACK direct;
+    direct.initialize(system_matrix);
+    direct.vmult(x, system_rhs);
+    constraints.distribute(x);
+
+    Vector<double> residual(rhs.size());
+    matrix.residual(residual, x, rhs);
+    lambda = ActiveSetSolver::multipliers(residual, base, pairs, active);
+    excess.resize(pairs.size());
+    for (unsigned int p = 0; p < pairs.size(); ++p)
+      excess[p] = pairs[p].jump(x) - pairs[p].gap;
+  }
+
+
+
+  double
+  FullContactSystem::displacement_scale() const
+  {
+    return x.linfty_norm();
+  }
+
+
+
+  void
+  FullContactSystem::solution(Vector<double> &result)
+  {
+    result = x;
+  }
+
+
+
   ContactSolution
-  ActiveSetSolver::solve(const SparseMatrix<double>      &matrix,
-                         const Vector<double>            &rhs,
+  ActiveSetSolver::solve(ContactSystem                   &system,
+                         const double                     force_scale_of_load,
                          const AffineConstraints<double> &base,
                          const std::vector<ContactPair>  &pairs,
                          const RigidModes                &rigid_modes,
                          const std::vector<bool>         &guess,
-                         Vector<double>                  &solution,
                          std::ostream                    &log) const
   {
     const unsigned int n_pairs = pairs.size();
@@ -286,15 +352,10 @@ namespace knee_contact
       }
 
     std::set<std::vector<bool>> seen;
-    SparseMatrix<double>        system_matrix(matrix.get_sparsity_pattern());
-    Vector<double>              system_rhs(rhs.size());
-    Vector<double>              residual(rhs.size());
-    AffineConstraints<double>   constraints;
-    solution.reinit(rhs.size());
+    std::vector<double>         excesses;
 
     for (unsigned int iteration = 1;; ++iteration)
       {
-        make_constraints(base, pairs, result.active, constraints);
         rigid_modes.check(
           base,
           pairs,
@@ -305,33 +366,24 @@ namespace knee_contact
             : "at active-set iteration " + std::to_string(iteration) +
                 " its load pulls it off its contact pairs");
 
-        system_matrix.copy_from(matrix);
-        system_rhs = rhs;
-        constraints.condense(system_matrix, system_rhs);
-        SparseDirectUMFPACK direct;
-        direct.initialize(system_matrix);
-        direct.vmult(solution, system_rhs);
-        constraints.distribute(solution);
-
-        matrix.residual(residual, solution, rhs);
-        result.lambda = multipliers(residual, base, pairs, result.active);
+        system.solve(result.active, excesses, result.lambda);
 
         // The active-set test of step-41, and the NCP residual
         // |min(lambda_p, g_p - (A x)_p)| scaled by max lambda and max |u|.
         double lambda_scale = 0;
         for (const double l : result.lambda)
           lambda_scale = std::max(lambda_scale, std::abs(l));
-        const double u_scale = std::max(solution.linfty_norm(), 1e-300);
+        const double u_scale = std::max(system.displacement_scale(), 1e-300);
         if (lambda_scale == 0)
           lambda_scale = 1;
-        const double      force_scale = rhs.linfty_norm() + lambda_scale;
+        const double      force_scale = force_scale_of_load + lambda_scale;
         std::vector<bool> next(n_pairs, false);
         unsigned int      n_entered = 0, n_left = 0, n_active = 0;
         result.complementarity = 0;
         result.max_penetration = -std::numeric_limits<double>::max();
         for (unsigned int p = 0; p < n_pairs; ++p)
           {
-            const double excess    = pairs[p].jump(solution) - pairs[p].gap;
+            const double excess    = excesses[p];
             result.max_penetration = std::max(result.max_penetration, excess);
             result.complementarity =
               std::max(result.complementarity,

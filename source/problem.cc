@@ -264,18 +264,50 @@ namespace knee_contact
               for (const auto &[position, length] : previous_contact)
                 if (contact_pairs[p].position.distance(position) <= length)
                   guess[p] = true;
+          std::ostream &loop_log = contact_pairs.empty() ? quiet : std::cout;
           try
             {
+              std::unique_ptr<ContactSystem> system;
+              if (active_set_solver.linear_solver() ==
+                  ActiveSetSolver::LinearSolver::condensed)
+                try
+                  {
+                    auto condensed = std::make_unique<CondensedContactSystem>(
+                      system_matrix, constraints, contact_pairs);
+                    condensed->set_rhs(system_rhs);
+                    system = std::move(condensed);
+                  }
+                catch (const CondensedContactSystem::ExcNotPositiveDefinite &)
+                  {
+                    // A body held by fewer contact unknowns than its rigid
+                    // motions (e.g. a single contact vertex) leaves C_ii
+                    // singular; the full path constrains before factorising.
+                    loop_log << "   the interior of a body is not held "
+                                "without its contact rows: using the step-41 "
+                                "solver"
+                             << std::endl;
+                  }
+              if (!system)
+                system = std::make_unique<FullContactSystem>(system_matrix,
+                                                             system_rhs,
+                                                             constraints,
+                                                             contact_pairs);
               contact_solution =
-                active_set_solver.solve(system_matrix,
-                                        system_rhs,
+                active_set_solver.solve(*system,
+                                        system_rhs.linfty_norm(),
                                         constraints,
                                         contact_pairs,
                                         rigid_modes,
                                         guess,
-                                        displacement,
-                                        contact_pairs.empty() ? quiet
-                                                              : std::cout);
+                                        loop_log);
+              system->solution(displacement);
+            }
+          catch (const CondensedContactSystem::ExcNotPositiveDefinite &)
+            {
+              AssertThrow(false,
+                          ExcMessage("the stiffness matrix is singular "
+                                     "under the active contact rows; check "
+                                     "that every body is held"));
             }
           catch (const SparseDirectUMFPACK::ExcUMFPACKError &exc)
             {

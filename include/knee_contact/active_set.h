@@ -2,6 +2,7 @@
 #define knee_contact_active_set_h
 
 #include <knee_contact/contact.h>
+#include <knee_contact/contact_system.h>
 #include <knee_contact/rigid_modes.h>
 
 #include <deal.II/base/parameter_handler.h>
@@ -42,9 +43,10 @@ namespace knee_contact
   /**
    * The primal-dual active set method of step-41/42 for the seed's QP
    * min 1/2 x^T C x - x^T d subject to A x <= g (its eq. (13) and P_d).
-   * Each iteration imposes the active rows as AffineConstraints lines,
-   * solves with UMFPACK, recovers the multipliers from the residual
-   * d - C x of the unconstrained system, and updates
+   * Each iteration solves with the active rows as equalities (a
+   * ContactSystem: condensed onto the contact unknowns, or step-41's
+   * UMFPACK solve of the whole system), recovers the multipliers from the
+   * residual d - C x, and updates
    *   A = {p : lambda_p + c ((A x)_p - g_p) > 0}.
    * deal.II has no contact solver for node pairs between bodies, so the
    * loop is written here.
@@ -59,20 +61,34 @@ namespace knee_contact
     parse_parameters(ParameterHandler &prm, const double max_youngs_modulus);
 
     /**
-     * Solve; @p matrix and @p rhs are the unconstrained C and d, and
-     * @p matrix's pattern must hold the entries of every condensed system.
-     * @p guess marks pairs to start active besides the touching ones (e.g.
-     * the contact zone of a coarser mesh); empty: none. @p log receives one
-     * line per iteration.
+     * How the linear systems of the loop are solved (see ContactSystem).
+     */
+    enum class LinearSolver
+    {
+      condensed,
+      step41
+    };
+
+    LinearSolver
+    linear_solver() const
+    {
+      return solver;
+    }
+
+    /**
+     * Run the loop on @p system. @p force_scale is |d|_inf (the load
+     * scale of the round-off test for unloaded contact). @p guess marks
+     * pairs to start active besides the touching ones (e.g. the contact
+     * zone of a coarser mesh); empty: none. @p log receives one line per
+     * iteration. The solution is then system.solution().
      */
     ContactSolution
-    solve(const SparseMatrix<double>      &matrix,
-          const Vector<double>            &rhs,
+    solve(ContactSystem                   &system,
+          const double                     force_scale,
           const AffineConstraints<double> &base,
           const std::vector<ContactPair>  &pairs,
           const RigidModes                &rigid_modes,
           const std::vector<bool>         &guess,
-          Vector<double>                  &solution,
           std::ostream                    &log) const;
 
     /**
@@ -110,6 +126,7 @@ namespace knee_contact
     double       c              = 0;
     double       tolerance      = 1e-10;
     bool         safeguard      = true;
+    LinearSolver solver         = LinearSolver::condensed;
   };
 } // namespace knee_contact
 

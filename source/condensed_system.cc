@@ -1,0 +1,660 @@
+#include <knee_contact/active_set.h>
+#include <knee_contact/contact_system.h>
+
+#include <deal.II/base/timer.h>
+
+#include <deal.II/lac/lapack_templates.h>
+
+#include <cholmod.h>
+#include <metis.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+#include <new>
+#include <stdexcept>
+
+namespace knee_contact
+{
+  namespace
+  {
+    /**
+     * C under the Gamma_u/Gamma_o/hanging lines, C0^T C C0 on the free dofs
+     * and a decoupled diagonal on the constrained ones, as
+     * AffineConstraints::condense() makes it; only its nonzero entries are
+     * kept (the pattern of the matrix also holds the couplings of every
+     * active set, which would only add fill here).
+     */
+    struct CondensedMatrix
+    {
+      std::vector<std::size_t>             row_start; // CSR over all dofs
+      std::vector<types::global_dof_index> column;
+      std::vector<double>                  value;
+    };
+
+    CondensedMatrix
+    condense(const SparseMatrix<double>      &matrix,
+             const AffineConstraints<double> &constraints)
+    {
+      SparseMatrix<double> copy(matrix.get_sparsity_pattern());
+      copy.copy_from(matrix);
+      constraints.condense(copy);
+      CondensedMatrix result;
+      const auto      n = matrix.m();
+      result.row_start.reserve(n + 1);
+      result.row_start.push_back(0);
+      for (types::global_dof_index i = 0; i < n; ++i)
+        {
+          for (auto it = copy.begin(i); it != copy.end(i); ++it)
+            if (it->value() != 0 || it->column() == i)
+              {
+                result.column.push_back(it->column());
+                result.value.push_back(it->value());
+              }
+          result.row_start.push_back(result.column.size());
+        }
+      return result;
+    }
+
+
+
+    /**
+     * C0^T (d - C g) on the free dofs, zero on the constrained ones: the
+     * right hand side of the condensed system for inhomogeneous lines
+     * x_i = sum_j c_ij x_j + g_i. (AffineConstraints condenses a vector
+     * only for homogeneous lines.)
+     */
+    Vector<double>
+    condense(const SparseMatrix<double>      &matrix,
+             const Vector<double>            &rhs,
+             const AffineConstraints<double> &constraints)
+    {
+      Vector<double> g(rhs.size());
+      for (const auto &line : constraints.get_lines())
+        g(line.index) = line.inhomogeneity;
+      Vector<double> b(rhs.size());
+      matrix.residual(b, g, rhs);
+      for (const auto &line : constraints.get_lines())
+        for (const auto &[j, c] : line.entries)
+          b(j) += c * b(line.index);
+      for (const auto &line : constraints.get_lines())
+        b(line.index) = 0;
+      return b;
+    }
+
+
+
+    /**
+     * A fill-reducing ordering: METIS nested dissection of the graph of
+     * mesh vertices (dofs with identical rows, the components of a vertex,
+     * are ordered together, which makes METIS several times faster than on
+     * the dofs), with the dofs in @p last (in their order) at the end.
+     * Returns perm with perm[new position] = dof.
+     */
+    std::vector<int>
+    fill_reducing_ordering(const CondensedMatrix                      &a,
+                           const std::vector<types::global_dof_index> &last)
+    {
+      const std::size_t n = a.row_start.size() - 1;
+      std::vector<bool> is_last(n, false);
+      for (const auto d : last)
+        is_last[d] = true;
+      // Dofs with identical rows (sorted: deal.II stores the diagonal
+      // first) belong to one vertex.
+      std::vector<int>              node_of(n, -1);
+      std::vector<std::vector<int>> dofs_of_node;
+      std::vector<types::global_dof_index> row_i, row_j;
+      const auto sorted = [&](const std::size_t i, auto &row) {
+        row.assign(a.column.begin() + a.row_start[i],
+                   a.column.begin() + a.row_start[i + 1]);
+        std::sort(row.begin(), row.end());
+      };
+      for (std::size_t i = 0; i < n; ++i)
+        if (!is_last[i])
+          {
+            if (i > 0 && !is_last[i - 1] &&
+                node_of[i - 1] >= 0 && dofs_of_node[node_of[i - 1]].size() < 3)
+              {
+                sorted(i - 1, row_j);
+                sorted(i, row_i);
+                if (row_i == row_j)
+                  {
+                    node_of[i] = node_of[i - 1];
+                    dofs_of_node[node_of[i]].push_back(i);
+                    continue;
+                  }
+              }
+            node_of[i] = dofs_of_node.size();
+            dofs_of_node.push_back({static_cast<int>(i)});
+          }
+
+      const idx_t        n_nodes = dofs_of_node.size();
+      std::vector<idx_t> xadj(n_nodes + 1, 0), adjncy;
+      std::vector<idx_t> neighbours;
+      for (idx_t v = 0; v < n_nodes; ++v)
+        {
+          neighbours.clear();
+          for (const int i : dofs_of_node[v])
+            for (std::size_t k = a.row_start[i]; k < a.row_start[i + 1]; ++k)
+              {
+                const auto j = a.column[k];
+                if (!is_last[j] && node_of[j] != v)
+                  neighbours.push_back(node_of[j]);
+              }
+          std::sort(neighbours.begin(), neighbours.end());
+          neighbours.erase(std::unique(neighbours.begin(), neighbours.end()),
+                           neighbours.end());
+          adjncy.insert(adjncy.end(), neighbours.begin(), neighbours.end());
+          xadj[v + 1] = adjncy.size();
+        }
+      std::vector<idx_t> perm(n_nodes), iperm(n_nodes);
+      if (n_nodes > 0)
+        {
+          idx_t options[METIS_NOPTIONS];
+          METIS_SetDefaultOptions(options);
+          options[METIS_OPTION_NUMBERING] = 0;
+          idx_t      nv     = n_nodes;
+          const auto status = METIS_NodeND(&nv,
+                                           xadj.data(),
+                                           adjncy.empty() ? nullptr :
+                                                            adjncy.data(),
+                                           nullptr,
+                                           options,
+                                           perm.data(),
+                                           iperm.data());
+          if (status == METIS_ERROR_MEMORY)
+            throw std::bad_alloc();
+          if (status != METIS_OK)
+            throw std::runtime_error("METIS failed to order the stiffness "
+                                     "matrix");
+        }
+      std::vector<int> order;
+      order.reserve(n);
+      for (const idx_t v : perm)
+        for (const int i : dofs_of_node[v])
+          order.push_back(i);
+      for (const auto d : last)
+        order.push_back(d);
+      return order;
+    }
+
+
+
+    /**
+     * CHOLMOD's supernodal LL^T of a symmetric positive definite matrix in
+     * a given order.
+     */
+    class SparseCholesky
+    {
+    public:
+      SparseCholesky()
+      {
+        cholmod_start(&common);
+        common.print                      = 0;
+        common.error_handler              = nullptr;
+        common.supernodal                 = CHOLMOD_SUPERNODAL;
+        common.nmethods                   = 1;
+        common.method[0].ordering         = CHOLMOD_GIVEN;
+        common.postorder                  = false;
+        common.quick_return_if_not_posdef = true;
+      }
+
+      ~SparseCholesky()
+      {
+        if (factor != nullptr)
+          cholmod_free_factor(&factor, &common);
+        cholmod_finish(&common);
+      }
+
+      SparseCholesky(const SparseCholesky &) = delete;
+      SparseCholesky &
+      operator=(const SparseCholesky &) = delete;
+
+      /**
+       * Factorise @p a plus @p shift on the diagonal of the last
+       * @p n_shifted dofs of @p order; false if not positive definite.
+       */
+      bool
+      factorise(const CondensedMatrix  &a,
+                const std::vector<int> &order,
+                const std::size_t       n_shifted,
+                const double            shift)
+      {
+        const std::size_t n = a.row_start.size() - 1;
+        std::vector<bool> shifted(n, false);
+        for (std::size_t k = order.size() - n_shifted; k < order.size(); ++k)
+          shifted[order[k]] = true;
+        // The upper triangle by columns is the lower one of C by rows.
+        std::size_t nnz = 0;
+        for (std::size_t i = 0; i < n; ++i)
+          for (std::size_t k = a.row_start[i]; k < a.row_start[i + 1]; ++k)
+            nnz += a.column[k] <= i;
+        cholmod_sparse *matrix = cholmod_allocate_sparse(
+          n, n, nnz, false, true, 1, CHOLMOD_REAL, &common);
+        check("allocate");
+        auto *p = static_cast<int *>(matrix->p);
+        auto *r = static_cast<int *>(matrix->i);
+        auto *x = static_cast<double *>(matrix->x);
+        nnz     = 0;
+        for (std::size_t i = 0; i < n; ++i)
+          {
+            p[i] = nnz;
+            for (std::size_t k = a.row_start[i]; k < a.row_start[i + 1]; ++k)
+              if (a.column[k] <= i)
+                {
+                  r[nnz] = a.column[k];
+                  x[nnz] = a.value[k] + (a.column[k] == i && shifted[i] ?
+                                           shift :
+                                           0.);
+                  ++nnz;
+                }
+          }
+        p[n] = nnz;
+
+        std::vector<int> perm(order.begin(), order.end());
+        factor = cholmod_analyze_p(matrix, perm.data(), nullptr, 0, &common);
+        check("analyse");
+        cholmod_factorize(matrix, factor, &common);
+        cholmod_free_sparse(&matrix, &common);
+        if (common.status == CHOLMOD_NOT_POSDEF)
+          return false;
+        check("factorise");
+        return true;
+      }
+
+      /**
+       * The trailing k x k block of L (positions n-k..n-1), dense,
+       * column-major, lower triangle.
+       */
+      std::vector<double>
+      trailing_block(const std::size_t k) const
+      {
+        const std::size_t   n = factor->n;
+        std::vector<double> block(k * k, 0.);
+        const auto *super = static_cast<const int *>(factor->super);
+        const auto *pi    = static_cast<const int *>(factor->pi);
+        const auto *px    = static_cast<const int *>(factor->px);
+        const auto *s     = static_cast<const int *>(factor->s);
+        const auto *x     = static_cast<const double *>(factor->x);
+        for (std::size_t sn = 0; sn < factor->nsuper; ++sn)
+          {
+            const std::size_t first = super[sn], end = super[sn + 1];
+            if (end <= n - k)
+              continue;
+            const std::size_t n_rows = pi[sn + 1] - pi[sn];
+            for (std::size_t col = std::max(first, n - k); col < end; ++col)
+              for (std::size_t r = 0; r < n_rows; ++r)
+                {
+                  const std::size_t row = s[pi[sn] + r];
+                  if (row >= col)
+                    block[(col - (n - k)) * k + (row - (n - k))] =
+                      x[px[sn] + r + (col - first) * n_rows];
+                }
+          }
+        return block;
+      }
+
+      /** x = solve(system, b) for CHOLMOD_P, _L, _Lt, _Pt, _A. */
+      void
+      solve(const int system, std::vector<double> &b)
+      {
+        cholmod_dense rhs;
+        rhs.nrow  = b.size();
+        rhs.ncol  = 1;
+        rhs.nzmax = b.size();
+        rhs.d     = b.size();
+        rhs.x     = b.data();
+        rhs.z     = nullptr;
+        rhs.xtype = CHOLMOD_REAL;
+        rhs.dtype = CHOLMOD_DOUBLE;
+        cholmod_dense *x = cholmod_solve(system, factor, &rhs, &common);
+        check("solve");
+        std::copy_n(static_cast<const double *>(x->x), b.size(), b.begin());
+        cholmod_free_dense(&x, &common);
+      }
+
+    private:
+      void
+      check(const char *what)
+      {
+        if (common.status == CHOLMOD_OUT_OF_MEMORY)
+          throw std::bad_alloc();
+        if (common.status < CHOLMOD_OK)
+          throw std::runtime_error(std::string("CHOLMOD failed to ") + what +
+                                   " (status " +
+                                   std::to_string(common.status) + ")");
+      }
+
+      cholmod_common  common;
+      cholmod_factor *factor = nullptr;
+    };
+
+
+
+    /** C = A A^T - shift I for a dense lower-triangular A (k x k). */
+    std::vector<double>
+    product_with_transpose(const std::vector<double> &a,
+                           const std::size_t          k,
+                           const double               shift)
+    {
+      std::vector<double> c(k * k, 0.);
+      if (k == 0)
+        return c;
+      const types::blas_int n = k;
+      const double one = 1, zero = 0;
+      syrk(
+        "L", "N", &n, &n, &one, a.data(), &n, &zero, c.data(), &n);
+      for (std::size_t j = 0; j < k; ++j)
+        {
+          c[j * k + j] -= shift;
+          for (std::size_t i = j + 1; i < k; ++i)
+            c[i * k + j] = c[j * k + i];
+        }
+      return c;
+    }
+  } // namespace
+
+
+
+  class CondensedContactSystem::Implementation
+  {
+  public:
+    const SparseMatrix<double>      &matrix;
+    const AffineConstraints<double> &base;
+    const std::vector<ContactPair>  &pairs;
+
+    /** Contact unknowns: global dof of each local index, and back. */
+    std::vector<types::global_dof_index>                   dofs;
+    std::map<types::global_dof_index, unsigned int>        local_of;
+    std::vector<std::vector<std::pair<unsigned, double>>> rows; // per pair
+    std::vector<int>                                       order;
+    SparseCholesky                                         cholesky;
+    double                                                 shift = 0;
+    std::vector<double> l_cc; // trailing block of L, column-major
+    std::vector<double> s;    // Schur complement, k x k, symmetric
+    std::vector<double> forward; // L^-1 P b of the current load case
+    std::vector<double> f;       // condensed right hand side
+    std::vector<double> x_c;     // contact unknowns of the last solve
+    Timings             timings;
+
+    Implementation(const SparseMatrix<double>      &matrix,
+                   const AffineConstraints<double> &base,
+                   const std::vector<ContactPair>  &pairs)
+      : matrix(matrix)
+      , base(base)
+      , pairs(pairs)
+    {}
+  };
+
+
+
+  CondensedContactSystem::CondensedContactSystem(
+    const SparseMatrix<double>      &matrix,
+    const AffineConstraints<double> &base,
+    const std::vector<ContactPair>  &pairs)
+    : implementation(std::make_unique<Implementation>(matrix, base, pairs))
+  {
+    Implementation &d = *implementation;
+    // Every free dof of an active-capable row is a contact unknown, in
+    // ascending order (deterministic).
+    std::set<types::global_dof_index> contact;
+    for (const auto &pair : pairs)
+      if (pair.eliminated != numbers::invalid_dof_index)
+        for (const auto &entry : pair.reduced_row)
+          contact.insert(entry.first);
+    d.dofs.assign(contact.begin(), contact.end());
+    for (unsigned int l = 0; l < d.dofs.size(); ++l)
+      d.local_of[d.dofs[l]] = l;
+    d.rows.resize(pairs.size());
+    for (unsigned int p = 0; p < pairs.size(); ++p)
+      if (pairs[p].eliminated != numbers::invalid_dof_index)
+        for (const auto &[dof, a] : pairs[p].reduced_row)
+          d.rows[p].emplace_back(d.local_of.at(dof), a);
+
+    Timer                 clock;
+    const CondensedMatrix a = condense(matrix, base);
+    d.order                 = fill_reducing_ordering(a, d.dofs);
+    d.timings.ordering      = clock.wall_time();
+
+    clock.restart();
+    // The shift only needs to make the trailing block positive definite:
+    // the largest diagonal entry does, and keeps S = L L^T - shift I at
+    // the round-off of C.
+    for (std::size_t i = 0; i + 1 < a.row_start.size(); ++i)
+      for (std::size_t k = a.row_start[i]; k < a.row_start[i + 1]; ++k)
+        if (a.column[k] == i)
+          d.shift = std::max(d.shift, std::abs(a.value[k]));
+    if (!d.cholesky.factorise(a, d.order, d.dofs.size(), d.shift))
+      AssertThrow(false, ExcNotPositiveDefinite());
+    d.timings.factorisation = clock.wall_time();
+
+    clock.restart();
+    const std::size_t k = d.dofs.size();
+    d.l_cc              = d.cholesky.trailing_block(k);
+    d.s                 = product_with_transpose(d.l_cc, k, d.shift);
+    d.timings.schur     = clock.wall_time();
+  }
+
+
+
+  CondensedContactSystem::~CondensedContactSystem() = default;
+
+
+
+  unsigned int
+  CondensedContactSystem::n_contact_unknowns() const
+  {
+    return implementation->dofs.size();
+  }
+
+
+
+  const CondensedContactSystem::Timings &
+  CondensedContactSystem::timings() const
+  {
+    return implementation->timings;
+  }
+
+
+
+  void
+  CondensedContactSystem::set_rhs(const Vector<double> &rhs)
+  {
+    Implementation &d = *implementation;
+    Timer           clock;
+    const auto      b = condense(d.matrix, rhs, d.base);
+    // y = L^-1 P b; with L = [L_ii 0; L_ci L_cc], f = b_c - C_ci C_ii^-1 b_i
+    // = L_cc y_c.
+    d.forward.assign(b.begin(), b.end());
+    d.cholesky.solve(CHOLMOD_P, d.forward);
+    d.cholesky.solve(CHOLMOD_L, d.forward);
+    const std::size_t k = d.dofs.size(), n = d.forward.size();
+    d.f.assign(k, 0.);
+    for (std::size_t j = 0; j < k; ++j)
+      for (std::size_t i = j; i < k; ++i)
+        d.f[i] += d.l_cc[j * k + i] * d.forward[n - k + j];
+    d.timings.condensation += clock.wall_time();
+  }
+
+
+
+  void
+  CondensedContactSystem::solve(const std::vector<bool> &active,
+                                std::vector<double>     &excess,
+                                std::vector<double>     &lambda)
+  {
+    Implementation   &d = *implementation;
+    Timer             clock;
+    const std::size_t k = d.dofs.size();
+    // The active rows, each solved for its eliminated dof, as constraints
+    // on the local indices; close() resolves chains (a row whose
+    // eliminated dof another row refers to), as in the full path.
+    AffineConstraints<double> lines;
+    for (unsigned int p = 0; p < d.pairs.size(); ++p)
+      if (active[p])
+        {
+          const unsigned int j   = d.local_of.at(d.pairs[p].eliminated);
+          double             a_j = 0;
+          for (const auto &[l, a] : d.rows[p])
+            if (l == j)
+              a_j = a;
+          lines.add_line(j);
+          for (const auto &[l, a] : d.rows[p])
+            if (l != j)
+              lines.add_entry(j, l, -a / a_j);
+          lines.set_inhomogeneity(j, d.pairs[p].reduced_gap / a_j);
+        }
+    lines.close();
+
+    // x_c = T y + t: column of each free local index, and T's entries per
+    // local index.
+    std::vector<int> free_index(k, -1);
+    unsigned int     m = 0;
+    for (unsigned int l = 0; l < k; ++l)
+      if (!lines.is_constrained(l))
+        free_index[l] = m++;
+    std::vector<std::vector<std::pair<unsigned, double>>> t_of(k);
+    std::vector<double>                                   t(k, 0.);
+    for (unsigned int l = 0; l < k; ++l)
+      if (free_index[l] >= 0)
+        t_of[l].emplace_back(free_index[l], 1.);
+      else
+        {
+          for (const auto &[i, c] : *lines.get_constraint_entries(l))
+            t_of[l].emplace_back(free_index[i], c);
+          t[l] = lines.get_inhomogeneity(l);
+        }
+
+    // R = T^T S T and r = T^T (f - S t); S T column by column (S is
+    // symmetric, so its rows serve as columns).
+    std::vector<double> st(std::size_t(k) * m, 0.);
+    for (unsigned int j = 0; j < k; ++j)
+      for (const auto &[b, c] : t_of[j])
+        {
+          const double *s_j = &d.s[j * k];
+          double       *col = &st[std::size_t(b) * k];
+          for (unsigned int i = 0; i < k; ++i)
+            col[i] += c * s_j[i];
+        }
+    std::vector<double> f_st = d.f;
+    for (unsigned int j = 0; j < k; ++j)
+      if (t[j] != 0)
+        for (unsigned int i = 0; i < k; ++i)
+          f_st[i] -= d.s[j * k + i] * t[j];
+    std::vector<double> reduced(std::size_t(m) * m, 0.); // column-major
+    std::vector<double> y(m, 0.);
+    for (unsigned int i = 0; i < k; ++i)
+      for (const auto &[a, c] : t_of[i])
+        {
+          y[a] += c * f_st[i];
+          for (unsigned int b = 0; b < m; ++b)
+            reduced[std::size_t(b) * m + a] += c * st[std::size_t(b) * k + i];
+        }
+    if (m > 0)
+      {
+        const types::blas_int n = m, one = 1;
+        types::blas_int       info = 0;
+        potrf("L", &n, reduced.data(), &n, &info);
+        AssertThrow(info == 0, ExcNotPositiveDefinite());
+        potrs("L", &n, &one, reduced.data(), &n, y.data(), &n, &info);
+        AssertThrow(info == 0, ExcInternalError());
+      }
+    d.x_c.assign(k, 0.);
+    for (unsigned int l = 0; l < k; ++l)
+      {
+        d.x_c[l] = t[l];
+        for (const auto &[a, c] : t_of[l])
+          d.x_c[l] += c * y[a];
+      }
+
+    // Multipliers from the condensed residual r_c = f - S x_c, which is
+    // A'^T lambda on the contact unknowns.
+    Vector<double> residual(d.matrix.m());
+    for (unsigned int i = 0; i < k; ++i)
+      {
+        double r = d.f[i];
+        for (unsigned int j = 0; j < k; ++j)
+          r -= d.s[j * k + i] * d.x_c[j];
+        residual(d.dofs[i]) = r;
+      }
+    lambda = ActiveSetSolver::multipliers(residual,
+                                          AffineConstraints<double>(),
+                                          d.pairs,
+                                          active);
+    excess.assign(d.pairs.size(), 0.);
+    for (unsigned int p = 0; p < d.pairs.size(); ++p)
+      {
+        excess[p] = -d.pairs[p].reduced_gap;
+        for (const auto &[l, a] : d.rows[p])
+          excess[p] += a * d.x_c[l];
+      }
+    d.timings.dense += clock.wall_time();
+  }
+
+
+
+  double
+  CondensedContactSystem::displacement_scale() const
+  {
+    double scale = 0;
+    for (const double x : implementation->x_c)
+      scale = std::max(scale, std::abs(x));
+    return scale;
+  }
+
+
+
+  void
+  CondensedContactSystem::solution(Vector<double> &x)
+  {
+    Implementation   &d = *implementation;
+    Timer             clock;
+    const std::size_t k = d.dofs.size(), n = d.forward.size();
+    // z = [y_i; L_cc^T x_c], then x = P^T L^-T z.
+    std::vector<double> z = d.forward;
+    for (std::size_t j = 0; j < k; ++j)
+      {
+        double sum = 0;
+        for (std::size_t i = j; i < k; ++i)
+          sum += d.l_cc[j * k + i] * d.x_c[i];
+        z[n - k + j] = sum;
+      }
+    d.cholesky.solve(CHOLMOD_Lt, z);
+    d.cholesky.solve(CHOLMOD_Pt, z);
+    x.reinit(n);
+    std::copy(z.begin(), z.end(), x.begin());
+    for (std::size_t l = 0; l < k; ++l)
+      x(d.dofs[l]) = d.x_c[l];
+    d.base.distribute(x);
+    d.timings.expansion += clock.wall_time();
+  }
+
+
+
+  double
+  reference_solve(const SparseMatrix<double>      &matrix,
+                  const Vector<double>            &rhs,
+                  const AffineConstraints<double> &base,
+                  const std::vector<ContactPair>  &pairs,
+                  const std::vector<bool>         &active,
+                  Vector<double>                  &x)
+  {
+    AffineConstraints<double> constraints;
+    ActiveSetSolver::make_constraints(base, pairs, active, constraints);
+    Timer                 clock;
+    const CondensedMatrix a = condense(matrix, constraints);
+    const auto            b = condense(matrix, rhs, constraints);
+    const auto            order = fill_reducing_ordering(a, {});
+    SparseCholesky        cholesky;
+    AssertThrow(cholesky.factorise(a, order, 0, 0.),
+                ExcMessage("the reference system is not positive definite"));
+    std::vector<double> z(b.begin(), b.end());
+    cholesky.solve(CHOLMOD_A, z);
+    const double time = clock.wall_time();
+    x.reinit(z.size());
+    std::copy(z.begin(), z.end(), x.begin());
+    constraints.distribute(x);
+    return time;
+  }
+} // namespace knee_contact
