@@ -404,7 +404,9 @@ namespace knee_contact
     const Results                       &results,
     const ContactSolution               &contact,
     const Materials                     &materials,
-    const std::map<std::string, double> &wall_times) const
+    const std::map<std::string, double> &wall_times,
+    const std::string                   &solver,
+    const std::map<std::string, double> &solver_figures) const
   {
     using json = nlohmann::ordered_json;
     json summary;
@@ -455,6 +457,9 @@ namespace knee_contact
       summary["warnings"] = warnings;
     for (const auto &[phase, seconds] : wall_times)
       summary["wall_time"][phase] = seconds;
+    summary["solver"]["name"] = solver;
+    for (const auto &[name, value] : solver_figures)
+      summary["solver"][name] = value;
     write_checked(staging("summary.json"),
                   output_folder + "/" + "summary.json",
                   [&](std::ostream &out) { out << summary.dump(2) << '\n'; });

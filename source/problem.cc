@@ -267,15 +267,19 @@ namespace knee_contact
           std::ostream &loop_log = contact_pairs.empty() ? quiet : std::cout;
           try
             {
+              solver_figures.clear();
+              Timer                          clock;
               std::unique_ptr<ContactSystem> system;
+              CondensedContactSystem        *condensed = nullptr;
               if (active_set_solver.linear_solver() ==
                   ActiveSetSolver::LinearSolver::condensed)
                 try
                   {
-                    auto condensed = std::make_unique<CondensedContactSystem>(
+                    auto made = std::make_unique<CondensedContactSystem>(
                       system_matrix, constraints, contact_pairs);
-                    condensed->set_rhs(system_rhs);
-                    system = std::move(condensed);
+                    made->set_rhs(system_rhs);
+                    condensed = made.get();
+                    system    = std::move(made);
                   }
                 catch (const CondensedContactSystem::ExcNotPositiveDefinite &)
                   {
@@ -292,6 +296,7 @@ namespace knee_contact
                                                              system_rhs,
                                                              constraints,
                                                              contact_pairs);
+              solver_name = condensed ? "condensed" : "step-41";
               contact_solution =
                 active_set_solver.solve(*system,
                                         system_rhs.linfty_norm(),
@@ -301,6 +306,34 @@ namespace knee_contact
                                         guess,
                                         loop_log);
               system->solution(displacement);
+              solver_figures["contact_solve"] = clock.wall_time();
+              if (condensed)
+                {
+                  const auto &t = condensed->timings();
+                  solver_figures["contact_unknowns"] =
+                    condensed->n_contact_unknowns();
+                  solver_figures["ordering"]        = t.ordering;
+                  solver_figures["factorisation"]   = t.factorisation;
+                  solver_figures["schur_complement"] = t.schur;
+                  solver_figures["condensation"]    = t.condensation;
+                  solver_figures["active_set_loop"] = t.dense;
+                  solver_figures["expansion"]       = t.expansion;
+                }
+              if (active_set_solver.measure_reference())
+                {
+                  Vector<double> x;
+                  solver_figures["reference_solve"] =
+                    reference_solve(system_matrix,
+                                    system_rhs,
+                                    constraints,
+                                    contact_pairs,
+                                    contact_solution.active,
+                                    x);
+                  x -= displacement;
+                  solver_figures["reference_difference"] =
+                    x.linfty_norm() /
+                    std::max(displacement.linfty_norm(), 1e-300);
+                }
             }
           catch (const CondensedContactSystem::ExcNotPositiveDefinite &)
             {
@@ -439,7 +472,9 @@ namespace knee_contact
                                     contact_solution,
                                     materials,
                                     timer.get_summary_data(
-                                      TimerOutput::total_wall_time));
+                                      TimerOutput::total_wall_time),
+                                    solver_name,
+                                    solver_figures);
         TimerOutput::Scope scope(timer, "pictures");
         std::string        message;
         if (!output_writer.run_script("plot_results.py", message) ||
@@ -451,7 +486,9 @@ namespace knee_contact
                                         contact_solution,
                                         materials,
                                         timer.get_summary_data(
-                                          TimerOutput::total_wall_time));
+                                          TimerOutput::total_wall_time),
+                                        solver_name,
+                                        solver_figures);
           }
       }
     const auto wall_times =

@@ -76,6 +76,23 @@ namespace knee_contact
     }
 
     /**
+     * Whether to time one linear solve with the final active set held
+     * fixed (the benchmark's reference).
+     */
+    bool
+    measure_reference() const
+    {
+      return reference_solve;
+    }
+
+    /** Override the scene's Contact/Solver (tests compare the two). */
+    void
+    set_linear_solver(const LinearSolver linear_solver)
+    {
+      solver = linear_solver;
+    }
+
+    /**
      * Run the loop on @p system. @p force_scale is |d|_inf (the load
      * scale of the round-off test for unloaded contact). @p guess marks
      * pairs to start active besides the touching ones (e.g. the contact
@@ -127,6 +144,7 @@ namespace knee_contact
     double       tolerance      = 1e-10;
     bool         safeguard      = true;
     LinearSolver solver         = LinearSolver::condensed;
+    bool         reference_solve = false;
   };
 } // namespace knee_contact
 

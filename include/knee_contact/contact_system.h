@@ -42,9 +42,8 @@ namespace knee_contact
           std::vector<double>     &lambda) = 0;
 
     /**
-     * max |x_i| of the last solve over the dofs the system sees (all dofs,
-     * or the contact unknowns of a condensed system): the scale of the
-     * complementarity residual.
+     * max |x_i| of the last solve over the contact unknowns (the free dofs
+     * of the contact rows): the scale of the complementarity residual.
      */
     virtual double
     displacement_scale() const = 0;

@@ -94,11 +94,17 @@ namespace knee_contact
     write_file(const std::string                         &name,
                const std::function<void(std::ostream &)> &write) const;
 
+    /**
+     * summary.json; @p solver names the linear solver and @p solver_figures
+     * its phase times and sizes (section "solver").
+     */
     void
     write_summary(const Results                       &results,
                   const ContactSolution               &contact,
                   const Materials                     &materials,
-                  const std::map<std::string, double> &wall_times) const;
+                  const std::map<std::string, double> &wall_times,
+                  const std::string                   &solver,
+                  const std::map<std::string, double> &solver_figures) const;
 
     /**
      * Print a warning on the terminal and keep it for summary.json

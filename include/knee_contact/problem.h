@@ -24,6 +24,7 @@
 #include <deal.II/fe/fe_system.h>
 #include <deal.II/grid/tria.h>
 
+#include <map>
 #include <memory>
 #include <ostream>
 #include <sstream>
@@ -94,6 +95,11 @@ namespace knee_contact
     run();
 
     // Access for unit tests.
+    ActiveSetSolver &
+    contact_solver()
+    {
+      return active_set_solver;
+    }
     const DoFHandler<2> &
     dof_handler_of() const
     {
@@ -182,6 +188,12 @@ namespace knee_contact
     Vector<double>            system_rhs;
     Vector<double>            displacement;
     ContactSolution           contact_solution;
+    /**
+     * The last solve's solver figures for summary.json: phase times [s],
+     * number of contact unknowns, reference solve (see ActiveSetSolver).
+     */
+    std::map<std::string, double> solver_figures;
+    std::string                   solver_name;
     /** Positions and slave lengths of the last cycle's active pairs. */
     std::vector<std::pair<Point<2>, double>> previous_contact;
 

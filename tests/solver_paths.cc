@@ -1,0 +1,119 @@
+// The condensed solver against the step-41 path (the first version's
+// solver, an independent computation of the same QP: it factorises the whole
+// system with UMFPACK in every iteration instead of CHOLMOD once with a
+// Schur complement): on every contact test scene, among them floating bodies
+// held only by contact, sliding (rotated Gamma_o) boundaries, hanging nodes
+// of adaptive refinement and the active-set cycle with and without its
+// safeguard, both must end with the same exit code, the same active set and
+// iteration count, displacements equal to 1e-10 relative (max norm) and
+// multipliers to 1e-8 of the largest.
+
+#include <knee_contact/problem.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <string>
+
+using namespace dealii;
+using namespace knee_contact;
+
+namespace
+{
+  struct Run
+  {
+    int                 status = 0;
+    Vector<double>      x;
+    ContactSolution     contact;
+    std::size_t         n_dofs = 0;
+  };
+
+  Run
+  run(const std::string                  &scene,
+      const ActiveSetSolver::LinearSolver solver)
+  {
+    ContactProblem problem(SOURCE_DIR "/" + scene);
+    problem.contact_solver().set_linear_solver(solver);
+    Run result;
+    result.status  = problem.run();
+    result.x       = problem.solution();
+    result.contact = problem.contact();
+    result.n_dofs  = problem.dof_handler_of().n_dofs();
+    return result;
+  }
+
+  bool
+  compare(const std::string &scene)
+  {
+    const Run step41 = run(scene, ActiveSetSolver::LinearSolver::step41);
+    const Run condensed = run(scene, ActiveSetSolver::LinearSolver::condensed);
+    bool      ok        = step41.status == condensed.status &&
+                step41.x.size() == condensed.x.size() &&
+                step41.contact.active == condensed.contact.active &&
+                step41.contact.n_iterations == condensed.contact.n_iterations;
+    double dx = 0, dl = 0, l_scale = 1e-300;
+    if (ok)
+      {
+        Vector<double> difference = condensed.x;
+        difference -= step41.x;
+        dx = difference.linfty_norm() /
+             std::max(step41.x.linfty_norm(), 1e-300);
+        for (unsigned int p = 0; p < step41.contact.lambda.size(); ++p)
+          {
+            l_scale = std::max(l_scale, std::abs(step41.contact.lambda[p]));
+            dl      = std::max(dl,
+                          std::abs(step41.contact.lambda[p] -
+                                   condensed.contact.lambda[p]));
+          }
+        dl /= l_scale;
+        ok = dx <= 1e-10 && dl <= 1e-8;
+      }
+    unsigned int n_active = 0;
+    for (const bool a : step41.contact.active)
+      n_active += a;
+    std::cout << scene << ": exit " << step41.status << ", " << n_active
+              << " active pairs, " << step41.contact.n_iterations
+              << " iterations: " << (ok ? "same" : "DIFFERENT") << std::endl;
+    if (!ok)
+      std::cerr << scene << ": exit " << step41.status << " / "
+                << condensed.status << ", iterations "
+                << step41.contact.n_iterations << " / "
+                << condensed.contact.n_iterations << ", active sets "
+                << (step41.contact.active == condensed.contact.active ?
+                      "equal" :
+                      "differ")
+                << ", |dx|/|x| = " << dx << ", |dlambda|/|lambda| = " << dl
+                << std::endl;
+    return ok;
+  }
+} // namespace
+
+int
+main()
+{
+  const char *scenes[] = {"contact_patch_matching.prm",
+                          "contact_patch_nonmatching.prm",
+                          "contact_separation.prm",
+                          "sliding_rotated_square.prm",
+                          "hertz_small.prm",
+                          "hertz_study_small.prm",
+                          "knee_small.prm",
+                          "knee_frontal_small.prm",
+                          "qp_scene.prm",
+                          "qp_scene_mortar.prm",
+                          "../prm/hard/floating_pressed.prm",
+                          "../prm/hard/rigid_sliding.prm",
+                          "../prm/hard/active_set_cycle.prm",
+                          "../prm/hard/active_set_cycle_unsafeguarded.prm",
+                          "../prm/hard/partial_closure.prm",
+                          "../prm/hard/contrast_1e6.prm",
+                          "../prm/hard/incompressible.prm",
+                          "../prm/hard/large_gap.prm",
+                          "../prm/hard/many_pairs.prm",
+                          "../prm/hard/thin_layer.prm",
+                          "../prm/hard/zero_load.prm"};
+  bool all = true;
+  for (const std::string scene : scenes)
+    all = compare(scene) && all;
+  return all ? 0 : 1;
+}
