@@ -466,6 +466,9 @@ namespace knee_contact
       }
     if (output_writer.enabled())
       {
+        Utilities::System::MemoryStats memory;
+        Utilities::System::get_memory_stats(memory);
+        solver_figures["peak_memory_MB"] = memory.VmHWM / 1024.;
         // The pictures read summary.json; a picture failure is kept in it
         // as a warning.
         output_writer.write_summary(results,
@@ -555,25 +558,38 @@ namespace knee_contact
     // A reaction component that is zero by physics comes out as round-off
     // of the force scale (1e-8 N/m beside 1e6 N/m); printed as it is, it
     // would make every comparison of this table with an earlier run fail on
-    // noise. Components below 1e-10 of the largest force are shown as 0.
-    double force_scale = results.applied_load.norm();
+    // noise. Components below 1e-10 of the force scale (the largest
+    // force, or E max |u| where no force is applied: a rigid motion) are
+    // shown as 0; so are an energy below 1e-10 E max|u|^2 and a stress
+    // below 1e-12 E.
+    const double E           = materials.max_youngs_modulus();
+    double       force_scale = std::max(results.applied_load.norm(),
+                                  E * results.max_displacement);
     for (const auto &[id, reaction] : results.reactions)
       force_scale = std::max(force_scale, reaction.norm());
     const auto shown = [force_scale](const double f) {
       return std::abs(f) <= 1e-10 * force_scale ? 0. : f;
+    };
+    const double energy_noise =
+      1e-10 * E * results.max_displacement * results.max_displacement;
+    const auto shown_stress = [E](const double s) {
+      return std::abs(s) <= 1e-12 * E ? 0. : s;
     };
     for (const auto &[id, reaction] : results.reactions)
       out << "  reaction at boundary id " << std::setw(3) << id << " [N/m] ("
           << shown(reaction[0]) << ", " << shown(reaction[1]) << ")\n";
     out << "  equilibrium residual         " << std::setprecision(2)
         << results.equilibrium_residual << std::setprecision(6) << "\n"
-        << "  energy a(u,u) [J/m]          " << results.energy << "\n"
+        << "  energy a(u,u) [J/m]          "
+        << (std::abs(results.energy) <= energy_noise ? 0. : results.energy)
+        << "\n"
         << "  max |u| [m]                  " << results.max_displacement
         << "\n";
     for (const auto &[id, range] : results.stress_yy_range)
       out << "  tau_yy [Pa] in " << std::left << std::setw(14)
-          << materials[id].name << std::right << " [" << range.first << ", "
-          << range.second << "]\n";
+          << materials[id].name << std::right << " ["
+          << shown_stress(range.first) << ", " << shown_stress(range.second)
+          << "]\n";
     for (const auto &i : results.interfaces)
       out << "  contact '" << i.name << "': " << i.n_active << " of "
           << i.n_pairs << " pairs active, force [N/m] " << i.force

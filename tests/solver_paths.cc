@@ -6,13 +6,18 @@
 // of adaptive refinement and the active-set cycle with and without its
 // safeguard, both must end with the same exit code, the same active set and
 // iteration count, displacements equal to 1e-10 relative (max norm) and
-// multipliers to 1e-8 of the largest.
+// multipliers to 1e-10 of the largest. Where the Young's moduli differ by a
+// contrast r, the condition number of C and with it the round-off of either
+// direct solve grows with r: there the tolerance is 1e-12 r if that is
+// larger (measured: knee_small, r = 338: 1.4e-10; knee_frontal_small,
+// r = 588: 1.0e-10; contrast_1e6: 1.3e-9).
 
 #include <knee_contact/problem.h>
 
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <sstream>
 #include <string>
 
 using namespace dealii;
@@ -23,9 +28,11 @@ namespace
   struct Run
   {
     int                 status = 0;
+    std::string         error; // first line of a refusal
     Vector<double>      x;
     ContactSolution     contact;
     std::size_t         n_dofs = 0;
+    double              contrast = 1;
   };
 
   Run
@@ -35,10 +42,27 @@ namespace
     ContactProblem problem(SOURCE_DIR "/" + scene);
     problem.contact_solver().set_linear_solver(solver);
     Run result;
-    result.status  = problem.run();
+    // The runs' own tables are not part of this test's output.
+    std::ostringstream quiet;
+    std::streambuf    *terminal = std::cout.rdbuf(quiet.rdbuf());
+    try
+      {
+        result.status = problem.run();
+      }
+    catch (const ExceptionBase &exc)
+      {
+        // A refusal (e.g. a body pulled off its contact) must be the same
+        // refusal on both paths.
+        result.status = -1;
+        const std::string what = exc.what();
+        result.error = what.substr(0, what.find("Stacktrace"));
+      }
+    std::cout.rdbuf(terminal);
     result.x       = problem.solution();
     result.contact = problem.contact();
     result.n_dofs  = problem.dof_handler_of().n_dofs();
+    result.contrast = problem.materials_of().max_youngs_modulus() /
+                      problem.materials_of().min_youngs_modulus();
     return result;
   }
 
@@ -48,6 +72,7 @@ namespace
     const Run step41 = run(scene, ActiveSetSolver::LinearSolver::step41);
     const Run condensed = run(scene, ActiveSetSolver::LinearSolver::condensed);
     bool      ok        = step41.status == condensed.status &&
+                step41.error == condensed.error &&
                 step41.x.size() == condensed.x.size() &&
                 step41.contact.active == condensed.contact.active &&
                 step41.contact.n_iterations == condensed.contact.n_iterations;
@@ -66,12 +91,16 @@ namespace
                                    condensed.contact.lambda[p]));
           }
         dl /= l_scale;
-        ok = dx <= 1e-10 && dl <= 1e-8;
+        const double tolerance = std::max(1e-10, 1e-12 * step41.contrast);
+        ok                     = dx <= tolerance && dl <= tolerance;
       }
     unsigned int n_active = 0;
     for (const bool a : step41.contact.active)
       n_active += a;
-    std::cout << scene << ": exit " << step41.status << ", " << n_active
+    std::cout << scene << ": "
+              << (step41.error.empty() ? "exit " + std::to_string(step41.status) :
+                                         std::string("refused"))
+              << ", " << n_active
               << " active pairs, " << step41.contact.n_iterations
               << " iterations: " << (ok ? "same" : "DIFFERENT") << std::endl;
     if (!ok)

@@ -100,6 +100,11 @@ namespace knee_contact
     {
       return active_set_solver;
     }
+    const Materials &
+    materials_of() const
+    {
+      return materials;
+    }
     const DoFHandler<2> &
     dof_handler_of() const
     {

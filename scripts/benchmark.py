@@ -1,0 +1,204 @@
+#!/usr/bin/env python3
+"""Speed of the contact solve against one linear solve, per mesh size.
+
+    python3 scripts/benchmark.py build/knee_contact [--max-dofs 1.8e6]
+        [--step41-max-dofs 5e5] [--repeat 1] [--scenes hertz,knee]
+
+For every scene (Hertz, prm/hertz.prm with lc_fine 0.02, lc_coarse 0.1; the
+sagittal knee, prm/knee.prm) and every number of global refinements up to
+--max-dofs, knee_contact runs the scene with Contact/Solver = condensed and
+Contact/Reference solve = true, so that one run gives both numbers of the
+ratio: the whole contact solve (ordering, factorisation, Schur complement,
+active-set loop, expansion) and one linear solve of the same mesh with the
+final active set held fixed (CHOLMOD with the same METIS vertex ordering:
+condensation of the constraints, ordering, factorisation, solve). Up to
+--step41-max-dofs the first version's path (Contact/Solver = step-41: UMFPACK
+in every iteration) runs too: before and after. With --repeat N each run is
+repeated and every figure is the median.
+
+Printed: one table per scene (times in seconds, memory = peak resident set
+of the run per dof) and the exponent b of a least-squares fit time = a n^b
+over the sizes >= 1e4 dofs. Pictures are off; output is the VTU and CSVs.
+"""
+
+import argparse
+import json
+import math
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+SCENES = {
+    "hertz": ("prm/hertz.prm",
+              {("Mesh", "Gmsh arguments"):
+               "-setnumber lc_fine 0.02 -setnumber lc_coarse 0.1"}),
+    "knee": ("prm/knee.prm", {}),
+}
+
+
+def set_entries(text, scene_dir, changes):
+    """The scene with each (subsection path, name) of changes set; entries
+    that are absent are added to their subsection (created if needed), and
+    Mesh/File is made absolute."""
+    lines = text.splitlines()
+    path, done, out = [], set(), []
+    for line in lines:
+        words = line.split()
+        if words[:1] == ["subsection"]:
+            path.append(line.split(None, 1)[1].strip())
+        elif words[:1] == ["end"]:
+            # Add what belongs to this subsection and is not there yet.
+            for (where, name), value in changes.items():
+                if "/".join(where) == "/".join(path) and \
+                        (where, name) not in done:
+                    out.append("  set %s = %s" % (name, value))
+                    done.add((where, name))
+            path.pop()
+        elif words[:1] == ["set"]:
+            name, value = line.split(None, 1)[1].split("=", 1)
+            key = (tuple(path), name.strip())
+            if key in changes:
+                line = "  set %s = %s" % (name.strip(), changes[key])
+                done.add(key)
+            elif key == (("Mesh",), "File") and value.strip() and \
+                    not os.path.isabs(value.strip()):
+                line = "  set File = " + os.path.join(scene_dir, value.strip())
+        out.append(line)
+    for (where, name), value in changes.items():
+        if (where, name) not in done:
+            out += ["subsection " + w for w in where]
+            out.append("  set %s = %s" % (name, value))
+            out += ["end"] * len(where)
+            done.add((where, name))
+    return "\n".join(out) + "\n"
+
+
+def run(program, scene, changes, work):
+    scene_path = os.path.join(ROOT, scene)
+    changes = dict(changes)
+    folder = os.path.join(work, "out")
+    changes[("Output",), "Folder"] = folder
+    changes[("Output",), "Pictures"] = "false"
+    text = set_entries(open(scene_path).read(), os.path.dirname(scene_path),
+                       changes)
+    path = os.path.join(work, "scene.prm")
+    with open(path, "w") as f:
+        f.write(text)
+    done = subprocess.run([program, path], stdout=subprocess.PIPE,
+                          stderr=subprocess.STDOUT, text=True)
+    if done.returncode != 0:
+        sys.exit("benchmark: %s failed (exit %d):\n%s" %
+                 (scene, done.returncode, done.stdout[-2000:]))
+    return json.load(open(os.path.join(folder, "summary.json")))
+
+
+def median_run(program, scene, changes, work, repeat):
+    runs = [run(program, scene, changes, work) for _ in range(repeat)]
+
+    def median(get):
+        return statistics.median(get(r) for r in runs)
+    first = runs[0]
+    solver = first["solver"]
+    figures = {
+        "dofs": first["n_dofs"],
+        "pairs": first["n_contact_pairs"],
+        "iterations": first["active_set_iterations"],
+        "k": solver.get("contact_unknowns", 0),
+        "contact": median(lambda r: r["solver"]["contact_solve"]),
+        "reference": median(lambda r: r["solver"].get("reference_solve", 0)),
+        "difference": max(r["solver"].get("reference_difference", 0)
+                          for r in runs),
+        "memory": median(lambda r: r["solver"]["peak_memory_MB"]),
+    }
+    for phase in ["ordering", "factorisation", "schur_complement",
+                  "active_set_loop", "expansion"]:
+        figures[phase] = median(lambda r: r["solver"].get(phase, 0))
+    for phase in ["setup", "assembly", "output"]:
+        figures[phase] = median(lambda r: r["wall_time"].get(phase, 0))
+    return figures
+
+
+def exponent(sizes, times):
+    points = [(math.log(n), math.log(t)) for n, t in zip(sizes, times)
+              if n >= 1e4 and t > 0]
+    if len(points) < 2:
+        return float("nan")
+    mx = sum(p[0] for p in points) / len(points)
+    my = sum(p[1] for p in points) / len(points)
+    return sum((x - mx) * (y - my) for x, y in points) / \
+        sum((x - mx) ** 2 for x, _ in points)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("program")
+    parser.add_argument("--max-dofs", type=float, default=1.8e6)
+    parser.add_argument("--step41-max-dofs", type=float, default=5e5)
+    parser.add_argument("--repeat", type=int, default=1)
+    parser.add_argument("--scenes", default="hertz,knee")
+    args = parser.parse_args()
+    program = os.path.abspath(args.program)
+
+    for name in args.scenes.split(","):
+        scene, base = SCENES[name]
+        rows = []
+        with tempfile.TemporaryDirectory(prefix="benchmark-") as work:
+            for level in range(10):
+                changes = dict(base)
+                changes[("Mesh",), "Global refinements"] = str(level)
+                changes[("Contact",), "Solver"] = "condensed"
+                changes[("Contact",), "Reference solve"] = "true"
+                row = median_run(program, scene, changes, work, args.repeat)
+                row["step41"] = float("nan")
+                if row["dofs"] <= args.step41_max_dofs:
+                    changes[("Contact",), "Solver"] = "step-41"
+                    changes[("Contact",), "Reference solve"] = "false"
+                    old = median_run(program, scene, changes, work,
+                                     args.repeat)
+                    row["step41"] = old["contact"]
+                    row["step41_iterations"] = old["iterations"]
+                rows.append(row)
+                print("%s: %d dofs done" % (name, row["dofs"]),
+                      file=sys.stderr, flush=True)
+                if 4 * row["dofs"] > args.max_dofs:
+                    break
+
+        print("\n%s (%s), median of %d run(s)" % (name, scene, args.repeat))
+        header = ("dofs", "pairs", "k", "it", "one solve", "contact",
+                  "ratio", "step-41", "speed-up", "order", "factor", "Schur",
+                  "loop", "expand", "setup", "assembly", "output",
+                  "kB/dof")
+        print("| " + " | ".join(header) + " |")
+        print("|" + "---|" * len(header))
+        for r in rows:
+            print("| %d | %d | %d | %d | %.3g | %.3g | %.2f | %.3g | %.1f | "
+                  "%.3g | %.3g | %.3g | %.3g | %.3g | %.3g | %.3g | %.3g | "
+                  "%.2f |" % (
+                      r["dofs"], r["pairs"], r["k"], r["iterations"],
+                      r["reference"], r["contact"],
+                      r["contact"] / r["reference"], r["step41"],
+                      r["step41"] / r["contact"], r["ordering"],
+                      r["factorisation"], r["schur_complement"],
+                      r["active_set_loop"], r["expansion"], r["setup"],
+                      r["assembly"], r["output"],
+                      r["memory"] * 1024 / r["dofs"]))
+        sizes = [r["dofs"] for r in rows]
+        print("fitted exponent (time ~ dofs^b, sizes >= 1e4): contact solve "
+              "%.2f, one solve %.2f, step-41 %.2f" % (
+                  exponent(sizes, [r["contact"] for r in rows]),
+                  exponent(sizes, [r["reference"] for r in rows]),
+                  exponent([r["dofs"] for r in rows
+                            if not math.isnan(r["step41"])],
+                           [r["step41"] for r in rows
+                            if not math.isnan(r["step41"])])))
+        print("largest difference of the contact solution from the "
+              "reference solve (relative, max norm): %.1e" %
+              max(r["difference"] for r in rows))
+
+
+if __name__ == "__main__":
+    main()
