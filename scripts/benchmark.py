@@ -34,7 +34,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 SCENES = {
     "hertz": ("prm/hertz.prm",
-              {("Mesh", "Gmsh arguments"):
+              {(("Mesh",), "Gmsh arguments"):
                "-setnumber lc_fine 0.02 -setnumber lc_coarse 0.1"}),
     "knee": ("prm/knee.prm", {}),
 }

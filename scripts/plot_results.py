@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Pictures of a knee_contact result folder (Debian's python3-matplotlib).
 
-Reads cells.csv, summary.json and contact_*.csv written by knee_contact and
+Reads cells.npy, summary.json and contact_*.csv written by knee_contact and
 draws, each written to a temporary name and renamed:
   deformation.png       the deformed mesh (displacement magnified as the scene
                         asks, the seed's Fig. 2) over the undeformed outline,
@@ -33,8 +33,7 @@ def save(figure, path):
 
 
 def read_cells(folder):
-    data = np.loadtxt(os.path.join(folder, "cells.csv"), delimiter=",",
-                      skiprows=1, ndmin=2)
+    data = np.load(os.path.join(folder, "cells.npy")).astype(float)
     material = data[:, 0].astype(int)
     vertex = data[:, 2:].reshape(len(data), 4, 5)
     return material, vertex  # vertex[cell, k] = x, y, u_x, u_y, stress_yy

@@ -79,8 +79,8 @@ namespace knee_contact
     tolerance      = prm.get_double("Tolerance");
     safeguard      = prm.get_bool("Cycle safeguard");
     reference_solve = prm.get_bool("Reference solve");
-    solver         = prm.get("Solver") == "step-41" ? LinearSolver::step41 :
-                                                      LinearSolver::condensed;
+    solver          = prm.get("Solver") == "step-41" ? LinearSolver::step41
+                                                     : LinearSolver::condensed;
     AssertThrow(c > 0, ExcMessage("Contact/Active set constant must be > 0"));
     prm.leave_subsection();
   }

@@ -11,8 +11,8 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <set>
 #include <new>
+#include <set>
 #include <stdexcept>
 
 namespace knee_contact
@@ -102,8 +102,8 @@ namespace knee_contact
         is_last[d] = true;
       // Dofs with identical rows (sorted: deal.II stores the diagonal
       // first) belong to one vertex.
-      std::vector<int>              node_of(n, -1);
-      std::vector<std::vector<int>> dofs_of_node;
+      std::vector<int>                     node_of(n, -1);
+      std::vector<std::vector<int>>        dofs_of_node;
       std::vector<types::global_dof_index> row_i, row_j;
       const auto sorted = [&](const std::size_t i, auto &row) {
         row.assign(a.column.begin() + a.row_start[i],
@@ -113,8 +113,8 @@ namespace knee_contact
       for (std::size_t i = 0; i < n; ++i)
         if (!is_last[i])
           {
-            if (i > 0 && !is_last[i - 1] &&
-                node_of[i - 1] >= 0 && dofs_of_node[node_of[i - 1]].size() < 3)
+            if (i > 0 && !is_last[i - 1] && node_of[i - 1] >= 0 &&
+                dofs_of_node[node_of[i - 1]].size() < 3)
               {
                 sorted(i - 1, row_j);
                 sorted(i, row_i);
@@ -154,15 +154,15 @@ namespace knee_contact
           idx_t options[METIS_NOPTIONS];
           METIS_SetDefaultOptions(options);
           options[METIS_OPTION_NUMBERING] = 0;
-          idx_t      nv     = n_nodes;
-          const auto status = METIS_NodeND(&nv,
-                                           xadj.data(),
-                                           adjncy.empty() ? nullptr :
-                                                            adjncy.data(),
-                                           nullptr,
-                                           options,
-                                           perm.data(),
-                                           iperm.data());
+          idx_t      nv                   = n_nodes;
+          const auto status =
+            METIS_NodeND(&nv,
+                         xadj.data(),
+                         adjncy.empty() ? nullptr : adjncy.data(),
+                         nullptr,
+                         options,
+                         perm.data(),
+                         iperm.data());
           if (status == METIS_ERROR_MEMORY)
             throw std::bad_alloc();
           if (status != METIS_OK)
@@ -244,9 +244,8 @@ namespace knee_contact
               if (a.column[k] <= i)
                 {
                   r[nnz] = a.column[k];
-                  x[nnz] = a.value[k] + (a.column[k] == i && shifted[i] ?
-                                           shift :
-                                           0.);
+                  x[nnz] =
+                    a.value[k] + (a.column[k] == i && shifted[i] ? shift : 0.);
                   ++nnz;
                 }
           }
@@ -272,11 +271,11 @@ namespace knee_contact
       {
         const std::size_t   n = factor->n;
         std::vector<double> block(k * k, 0.);
-        const auto *super = static_cast<const int *>(factor->super);
-        const auto *pi    = static_cast<const int *>(factor->pi);
-        const auto *px    = static_cast<const int *>(factor->px);
-        const auto *s     = static_cast<const int *>(factor->s);
-        const auto *x     = static_cast<const double *>(factor->x);
+        const auto         *super = static_cast<const int *>(factor->super);
+        const auto         *pi    = static_cast<const int *>(factor->pi);
+        const auto         *px    = static_cast<const int *>(factor->px);
+        const auto         *s     = static_cast<const int *>(factor->s);
+        const auto         *x     = static_cast<const double *>(factor->x);
         for (std::size_t sn = 0; sn < factor->nsuper; ++sn)
           {
             const std::size_t first = super[sn], end = super[sn + 1];
@@ -300,14 +299,14 @@ namespace knee_contact
       solve(const int system, std::vector<double> &b)
       {
         cholmod_dense rhs;
-        rhs.nrow  = b.size();
-        rhs.ncol  = 1;
-        rhs.nzmax = b.size();
-        rhs.d     = b.size();
-        rhs.x     = b.data();
-        rhs.z     = nullptr;
-        rhs.xtype = CHOLMOD_REAL;
-        rhs.dtype = CHOLMOD_DOUBLE;
+        rhs.nrow         = b.size();
+        rhs.ncol         = 1;
+        rhs.nzmax        = b.size();
+        rhs.d            = b.size();
+        rhs.x            = b.data();
+        rhs.z            = nullptr;
+        rhs.xtype        = CHOLMOD_REAL;
+        rhs.dtype        = CHOLMOD_DOUBLE;
         cholmod_dense *x = cholmod_solve(system, factor, &rhs, &common);
         check("solve");
         std::copy_n(static_cast<const double *>(x->x), b.size(), b.begin());
@@ -322,8 +321,8 @@ namespace knee_contact
           throw std::bad_alloc();
         if (common.status < CHOLMOD_OK)
           throw std::runtime_error(std::string("CHOLMOD failed to ") + what +
-                                   " (status " +
-                                   std::to_string(common.status) + ")");
+                                   " (status " + std::to_string(common.status) +
+                                   ")");
       }
 
       cholmod_common  common;
@@ -341,10 +340,9 @@ namespace knee_contact
       std::vector<double> c(k * k, 0.);
       if (k == 0)
         return c;
-      const types::blas_int n = k;
-      const double one = 1, zero = 0;
-      syrk(
-        "L", "N", &n, &n, &one, a.data(), &n, &zero, c.data(), &n);
+      const types::blas_int n   = k;
+      const double          one = 1, zero = 0;
+      syrk("L", "N", &n, &n, &one, a.data(), &n, &zero, c.data(), &n);
       for (std::size_t j = 0; j < k; ++j)
         {
           c[j * k + j] -= shift;
@@ -365,14 +363,14 @@ namespace knee_contact
     const std::vector<ContactPair>  &pairs;
 
     /** Contact unknowns: global dof of each local index, and back. */
-    std::vector<types::global_dof_index>                   dofs;
-    std::map<types::global_dof_index, unsigned int>        local_of;
+    std::vector<types::global_dof_index>                  dofs;
+    std::map<types::global_dof_index, unsigned int>       local_of;
     std::vector<std::vector<std::pair<unsigned, double>>> rows; // per pair
-    std::vector<int>                                       order;
-    SparseCholesky                                         cholesky;
-    double                                                 shift = 0;
-    std::vector<double> l_cc; // trailing block of L, column-major
-    std::vector<double> s;    // Schur complement, k x k, symmetric
+    std::vector<int>                                      order;
+    SparseCholesky                                        cholesky;
+    double                                                shift = 0;
+    std::vector<double> l_cc;    // trailing block of L, column-major
+    std::vector<double> s;       // Schur complement, k x k, symmetric
     std::vector<double> forward; // L^-1 P b of the current load case
     std::vector<double> f;       // condensed right hand side
     std::vector<double> x_c;     // contact unknowns of the last solve
@@ -643,8 +641,8 @@ namespace knee_contact
     AffineConstraints<double> constraints;
     ActiveSetSolver::make_constraints(base, pairs, active, constraints);
     Timer                 clock;
-    const CondensedMatrix a = condense(matrix, constraints);
-    const auto            b = condense(matrix, rhs, constraints);
+    const CondensedMatrix a     = condense(matrix, constraints);
+    const auto            b     = condense(matrix, rhs, constraints);
     const auto            order = fill_reducing_ordering(a, {});
     SparseCholesky        cholesky;
     AssertThrow(cholesky.factorise(a, order, 0, 0.),

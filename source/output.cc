@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -262,6 +263,12 @@ namespace knee_contact
     data_out.add_data_vector(material_id, "material_id");
     data_out.add_data_vector(body_id, "body_id");
     data_out.build_patches();
+    // zlib's fastest level: the file is 10 % larger than at the default
+    // level and written several times faster (at 4e5 dofs the default took
+    // longer than the contact solve).
+    DataOutBase::VtkFlags flags;
+    flags.compression_level = DataOutBase::VtkFlags::best_speed;
+    data_out.set_flags(flags);
     write_checked(staging("solution.vtu"),
                   output_folder + "/" + "solution.vtu",
                   [&](std::ostream &out) { data_out.write_vtu(out); });
@@ -275,28 +282,51 @@ namespace knee_contact
                             const Vector<double>            &solution,
                             const Results                   &results) const
   {
-    write_checked(
-      staging("cells.csv"),
-      output_folder + "/cells.csv",
-      [&](std::ostream &out) {
-        out << "material_id,body_id";
-        for (unsigned int v = 0; v < 4; ++v)
-          for (const char *name : {"x", "y", "u_x", "u_y", "stress_yy"})
-            out << ',' << name << v;
-        out << '\n' << std::setprecision(9);
-        for (const auto &cell : dof_handler.active_cell_iterators())
+    // Binary (NumPy's .npy, float32, one row per cell: material id, body
+    // id, then x, y, u_x, u_y, stress_yy at the four vertices
+    // counter-clockwise): the picture script's input, smaller than the VTU
+    // and written in a fraction of the time a text file takes.
+    const unsigned int n_columns = 2 + 4 * 5;
+    std::vector<float> data;
+    data.reserve(std::size_t(dof_handler.get_triangulation().n_active_cells()) *
+                 n_columns);
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      {
+        data.push_back(cell->material_id());
+        data.push_back(body_of_cell[cell->active_cell_index()]);
+        // Counter-clockwise: deal.II's vertex order is 0 1 3 2.
+        for (const unsigned int v : {0u, 1u, 3u, 2u})
           {
-            out << static_cast<unsigned int>(cell->material_id()) << ','
-                << body_of_cell[cell->active_cell_index()];
-            // Counter-clockwise: deal.II's vertex order is 0 1 3 2.
-            for (const unsigned int v : {0u, 1u, 3u, 2u})
-              out << ',' << cell->vertex(v)[0] << ',' << cell->vertex(v)[1]
-                  << ',' << solution(cell->vertex_dof_index(v, 0)) << ','
-                  << solution(cell->vertex_dof_index(v, 1)) << ','
-                  << results.vertex_stress_yy[cell->active_cell_index()][v];
-            out << '\n';
+            data.push_back(cell->vertex(v)[0]);
+            data.push_back(cell->vertex(v)[1]);
+            data.push_back(solution(cell->vertex_dof_index(v, 0)));
+            data.push_back(solution(cell->vertex_dof_index(v, 1)));
+            data.push_back(
+              results.vertex_stress_yy[cell->active_cell_index()][v]);
           }
-      });
+      }
+    write_checked(staging("cells.npy"),
+                  output_folder + "/cells.npy",
+                  [&](std::ostream &out) {
+                    std::string header =
+                      "{'descr': '<f4', 'fortran_order': False, "
+                      "'shape': (" +
+                      std::to_string(data.size() / n_columns) + ", " +
+                      std::to_string(n_columns) + "), }";
+                    // Magic, version 1.0, header length; header padded with
+                    // spaces and a newline so that the data starts at a
+                    // multiple of 64 bytes.
+                    const std::size_t total = 10 + header.size() + 1;
+                    header += std::string((64 - total % 64) % 64, ' ') + "\n";
+                    const std::uint16_t length = header.size();
+                    out.write("\x93NUMPY\x01\x00", 8);
+                    out.put(static_cast<char>(length & 0xff));
+                    out.put(static_cast<char>(length >> 8));
+                    out << header;
+                    static_assert(sizeof(float) == 4, "float32 expected");
+                    out.write(reinterpret_cast<const char *>(data.data()),
+                              data.size() * sizeof(float));
+                  });
   }
 
 

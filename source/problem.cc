@@ -275,8 +275,10 @@ namespace knee_contact
                   ActiveSetSolver::LinearSolver::condensed)
                 try
                   {
-                    auto made = std::make_unique<CondensedContactSystem>(
-                      system_matrix, constraints, contact_pairs);
+                    auto made =
+                      std::make_unique<CondensedContactSystem>(system_matrix,
+                                                               constraints,
+                                                               contact_pairs);
                     made->set_rhs(system_rhs);
                     condensed = made.get();
                     system    = std::move(made);
@@ -312,12 +314,12 @@ namespace knee_contact
                   const auto &t = condensed->timings();
                   solver_figures["contact_unknowns"] =
                     condensed->n_contact_unknowns();
-                  solver_figures["ordering"]        = t.ordering;
-                  solver_figures["factorisation"]   = t.factorisation;
+                  solver_figures["ordering"]         = t.ordering;
+                  solver_figures["factorisation"]    = t.factorisation;
                   solver_figures["schur_complement"] = t.schur;
-                  solver_figures["condensation"]    = t.condensation;
-                  solver_figures["active_set_loop"] = t.dense;
-                  solver_figures["expansion"]       = t.expansion;
+                  solver_figures["condensation"]     = t.condensation;
+                  solver_figures["active_set_loop"]  = t.dense;
+                  solver_figures["expansion"]        = t.expansion;
                 }
               if (active_set_solver.measure_reference())
                 {
@@ -562,9 +564,9 @@ namespace knee_contact
     // force, or E max |u| where no force is applied: a rigid motion) are
     // shown as 0; so are an energy below 1e-10 E max|u|^2 and a stress
     // below 1e-12 E.
-    const double E           = materials.max_youngs_modulus();
-    double       force_scale = std::max(results.applied_load.norm(),
-                                  E * results.max_displacement);
+    const double E = materials.max_youngs_modulus();
+    double       force_scale =
+      std::max(results.applied_load.norm(), E * results.max_displacement);
     for (const auto &[id, reaction] : results.reactions)
       force_scale = std::max(force_scale, reaction.norm());
     const auto shown = [force_scale](const double f) {

@@ -27,17 +27,16 @@ namespace
 {
   struct Run
   {
-    int                 status = 0;
-    std::string         error; // first line of a refusal
-    Vector<double>      x;
-    ContactSolution     contact;
-    std::size_t         n_dofs = 0;
-    double              contrast = 1;
+    int             status = 0;
+    std::string     error; // first line of a refusal
+    Vector<double>  x;
+    ContactSolution contact;
+    std::size_t     n_dofs   = 0;
+    double          contrast = 1;
   };
 
   Run
-  run(const std::string                  &scene,
-      const ActiveSetSolver::LinearSolver solver)
+  run(const std::string &scene, const ActiveSetSolver::LinearSolver solver)
   {
     ContactProblem problem(SOURCE_DIR "/" + scene);
     problem.contact_solver().set_linear_solver(solver);
@@ -53,14 +52,14 @@ namespace
       {
         // A refusal (e.g. a body pulled off its contact) must be the same
         // refusal on both paths.
-        result.status = -1;
+        result.status          = -1;
         const std::string what = exc.what();
-        result.error = what.substr(0, what.find("Stacktrace"));
+        result.error           = what.substr(0, what.find("Stacktrace"));
       }
     std::cout.rdbuf(terminal);
-    result.x       = problem.solution();
-    result.contact = problem.contact();
-    result.n_dofs  = problem.dof_handler_of().n_dofs();
+    result.x        = problem.solution();
+    result.contact  = problem.contact();
+    result.n_dofs   = problem.dof_handler_of().n_dofs();
     result.contrast = problem.materials_of().max_youngs_modulus() /
                       problem.materials_of().min_youngs_modulus();
     return result;
@@ -69,20 +68,20 @@ namespace
   bool
   compare(const std::string &scene)
   {
-    const Run step41 = run(scene, ActiveSetSolver::LinearSolver::step41);
+    const Run step41    = run(scene, ActiveSetSolver::LinearSolver::step41);
     const Run condensed = run(scene, ActiveSetSolver::LinearSolver::condensed);
     bool      ok        = step41.status == condensed.status &&
-                step41.error == condensed.error &&
-                step41.x.size() == condensed.x.size() &&
-                step41.contact.active == condensed.contact.active &&
-                step41.contact.n_iterations == condensed.contact.n_iterations;
+              step41.error == condensed.error &&
+              step41.x.size() == condensed.x.size() &&
+              step41.contact.active == condensed.contact.active &&
+              step41.contact.n_iterations == condensed.contact.n_iterations;
     double dx = 0, dl = 0, l_scale = 1e-300;
     if (ok)
       {
         Vector<double> difference = condensed.x;
         difference -= step41.x;
-        dx = difference.linfty_norm() /
-             std::max(step41.x.linfty_norm(), 1e-300);
+        dx =
+          difference.linfty_norm() / std::max(step41.x.linfty_norm(), 1e-300);
         for (unsigned int p = 0; p < step41.contact.lambda.size(); ++p)
           {
             l_scale = std::max(l_scale, std::abs(step41.contact.lambda[p]));
@@ -98,19 +97,19 @@ namespace
     for (const bool a : step41.contact.active)
       n_active += a;
     std::cout << scene << ": "
-              << (step41.error.empty() ? "exit " + std::to_string(step41.status) :
-                                         std::string("refused"))
-              << ", " << n_active
-              << " active pairs, " << step41.contact.n_iterations
+              << (step41.error.empty() ? "exit " + std::to_string(step41.status)
+                                       : std::string("refused"))
+              << ", " << n_active << " active pairs, "
+              << step41.contact.n_iterations
               << " iterations: " << (ok ? "same" : "DIFFERENT") << std::endl;
     if (!ok)
       std::cerr << scene << ": exit " << step41.status << " / "
                 << condensed.status << ", iterations "
                 << step41.contact.n_iterations << " / "
                 << condensed.contact.n_iterations << ", active sets "
-                << (step41.contact.active == condensed.contact.active ?
-                      "equal" :
-                      "differ")
+                << (step41.contact.active == condensed.contact.active
+                      ? "equal"
+                      : "differ")
                 << ", |dx|/|x| = " << dx << ", |dlambda|/|lambda| = " << dl
                 << std::endl;
     return ok;
@@ -141,7 +140,7 @@ main()
                           "../prm/hard/many_pairs.prm",
                           "../prm/hard/thin_layer.prm",
                           "../prm/hard/zero_load.prm"};
-  bool all = true;
+  bool        all      = true;
   for (const std::string scene : scenes)
     all = compare(scene) && all;
   return all ? 0 : 1;

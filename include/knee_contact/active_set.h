@@ -139,11 +139,11 @@ namespace knee_contact
                 const std::vector<bool>         &active);
 
   private:
-    unsigned int max_iterations = 50;
-    double       c              = 0;
-    double       tolerance      = 1e-10;
-    bool         safeguard      = true;
-    LinearSolver solver         = LinearSolver::condensed;
+    unsigned int max_iterations  = 50;
+    double       c               = 0;
+    double       tolerance       = 1e-10;
+    bool         safeguard       = true;
+    LinearSolver solver          = LinearSolver::condensed;
     bool         reference_solve = false;
   };
 } // namespace knee_contact
