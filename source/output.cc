@@ -33,7 +33,16 @@ namespace knee_contact
       AssertThrow(out.good(),
                   ExcMessage("cannot write '" + shown +
                              "': " + std::strerror(errno)));
-      write(out);
+      try
+        {
+          write(out);
+        }
+      catch (const StandardExceptions::ExcIO &)
+        {
+          // DataOut checks its stream and throws ExcIO when a write fails
+          // (a full disk); the stream's state and errno tell why below.
+          out.setstate(std::ios::failbit);
+        }
       out.close();
       AssertThrow(!out.fail(),
                   ExcMessage("writing '" + shown + "' failed: " +

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# A full disk during output: the output folder lies on a small tmpfs that
+# A full disk during output: the output folder lies on a small tmpfs (200 kB;
+# uniaxial_block writes 16 kB, knee_small 350 kB) that
 # holds SMALL's result set but not BIG's. The run of BIG must exit 1 with
 # one line that says the device is full, leave SMALL's result set unchanged
 # and leave no staging folder. Needs root to mount the tmpfs; skipped
@@ -12,7 +13,7 @@ big=$3
 work=$(mktemp -d)
 trap 'umount "$work/disk" 2>/dev/null; rm -rf "$work"' EXIT
 mkdir "$work/disk"
-mount -t tmpfs -o size=400k tmpfs "$work/disk" 2>/dev/null ||
+mount -t tmpfs -o size=200k tmpfs "$work/disk" 2>/dev/null ||
   { echo "SKIP: cannot mount a tmpfs (not root)"; exit 77; }
 cd "$work"
 fail() { echo "FAIL: $*"; exit 1; }
