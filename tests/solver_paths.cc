@@ -31,7 +31,6 @@ namespace
     std::string     error; // first line of a refusal
     Vector<double>  x;
     ContactSolution contact;
-    std::size_t     n_dofs   = 0;
     double          contrast = 1;
   };
 
@@ -59,7 +58,6 @@ namespace
     std::cout.rdbuf(terminal);
     result.x        = problem.solution();
     result.contact  = problem.contact();
-    result.n_dofs   = problem.dof_handler_of().n_dofs();
     result.contrast = problem.materials_of().max_youngs_modulus() /
                       problem.materials_of().min_youngs_modulus();
     return result;
