@@ -266,17 +266,23 @@ namespace knee_contact
 
 
   FullContactSystem::FullContactSystem(const SparseMatrix<double>      &matrix,
-                                       const Vector<double>            &rhs,
                                        const AffineConstraints<double> &base,
                                        const std::vector<ContactPair>  &pairs)
     : matrix(matrix)
-    , rhs(rhs)
     , base(base)
     , pairs(pairs)
     , system_matrix(matrix.get_sparsity_pattern())
-    , system_rhs(rhs.size())
-    , x(rhs.size())
+    , system_rhs(matrix.m())
+    , x(matrix.m())
   {}
+
+
+
+  void
+  FullContactSystem::set_rhs(const Vector<double> &new_rhs)
+  {
+    rhs = &new_rhs;
+  }
 
 
 
@@ -287,16 +293,17 @@ namespace knee_contact
   {
     AffineConstraints<double> constraints;
     ActiveSetSolver::make_constraints(base, pairs, active, constraints);
+    Assert(rhs != nullptr, ExcMessage("set_rhs() was not called"));
     system_matrix.copy_from(matrix);
-    system_rhs = rhs;
+    system_rhs = *rhs;
     constraints.condense(system_matrix, system_rhs);
     SparseDirectUMFPACK direct;
     direct.initialize(system_matrix);
     direct.vmult(x, system_rhs);
     constraints.distribute(x);
 
-    Vector<double> residual(rhs.size());
-    matrix.residual(residual, x, rhs);
+    Vector<double> residual(rhs->size());
+    matrix.residual(residual, x, *rhs);
     lambda = ActiveSetSolver::multipliers(residual, base, pairs, active);
     excess.resize(pairs.size());
     for (unsigned int p = 0; p < pairs.size(); ++p)
@@ -338,7 +345,9 @@ namespace knee_contact
   {
     const unsigned int n_pairs = pairs.size();
     ContactSolution    result;
-    // Start from the pairs that touch (g_p <= 0) and the guess. A body that
+    // Start from the guess (the previous load case's or mesh's contact
+    // zone) if there is one, else from the pairs that touch (g_p <= 0). A
+    // body that
     // only contact holds (a floating femur, a mobile insert) may need more:
     // close the smallest gaps first, doubling their number, until every body is
     // held. The loop below releases any of them whose multiplier is negative.
@@ -347,7 +356,7 @@ namespace knee_contact
     for (unsigned int p = 0; p < n_pairs; ++p)
       if (pairs[p].eliminated != numbers::invalid_dof_index)
         {
-          if (pairs[p].gap <= 0 || (!guess.empty() && guess[p]))
+          if (guess.empty() ? pairs[p].gap <= 0 : bool(guess[p]))
             result.active[p] = true;
           else
             by_gap.push_back(p);

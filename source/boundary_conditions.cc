@@ -93,12 +93,12 @@ namespace knee_contact
                     ExcMessage(condition.name +
                                "/Components: no component selected"));
         if (condition.type != BoundaryType::sliding)
-          condition.function =
-            input::parse_expression(prm.get("Value"),
-                                    condition.type == BoundaryType::pressure
-                                      ? 1
-                                      : 2,
-                                    condition.name + "/Value");
+          condition.function = input::parse_expression(
+            prm.get("Value"),
+            condition.type == BoundaryType::pressure ? 1 : 2,
+            condition.name + "/Value",
+            "",
+            condition.type != BoundaryType::displacement);
         prm.leave_subsection();
         list.push_back(std::move(condition));
       }
@@ -152,5 +152,15 @@ namespace knee_contact
           AffineConstraints<double>::MergeConflictBehavior::left_object_wins);
       }
     constraints.close();
+  }
+
+
+  void
+  BoundaryConditions::set_load_parameter(const double t)
+  {
+    for (auto &condition : list)
+      if (condition.type == BoundaryType::traction ||
+          condition.type == BoundaryType::pressure)
+        condition.function->set_time(t);
   }
 } // namespace knee_contact

@@ -67,13 +67,34 @@ namespace knee_contact
                                 Vector<double>       &rhs) const
   {
     matrix = 0;
+    assemble(dof_handler, &matrix, rhs);
+  }
+
+
+
+  void
+  ElasticityAssembler::assemble_rhs(const DoFHandler<2> &dof_handler,
+                                    Vector<double>      &rhs) const
+  {
+    assemble(dof_handler, nullptr, rhs);
+  }
+
+
+
+  void
+  ElasticityAssembler::assemble(const DoFHandler<2>  &dof_handler,
+                                SparseMatrix<double> *matrix,
+                                Vector<double>       &rhs) const
+  {
     rhs.reinit(dof_handler.n_dofs());
+    const bool with_matrix = matrix != nullptr;
 
     // a(u, v) = int e(v) : c : e(u) dx and L(v) = int F.v dx + int P.v ds,
     // the seed's eq. (5), cell by cell.
-    const auto worker = [this](const DoFHandler<2>::active_cell_iterator &cell,
-                               ScratchData &scratch,
-                               CopyData    &copy) {
+    const auto worker = [this, with_matrix](
+                          const DoFHandler<2>::active_cell_iterator &cell,
+                          ScratchData                               &scratch,
+                          CopyData                                  &copy) {
       const FiniteElement<2> &fe       = cell->get_fe();
       const unsigned int      n        = fe.n_dofs_per_cell();
       const Material         &material = materials[cell->material_id()];
@@ -92,7 +113,7 @@ namespace knee_contact
             {
               const unsigned int ci = fe.system_to_component_index(i).first;
               const Tensor<1, 2> gi = fev.shape_grad(i, q);
-              for (unsigned int j = 0; j < n; ++j)
+              for (unsigned int j = 0; with_matrix && j < n; ++j)
                 {
                   const unsigned int cj = fe.system_to_component_index(j).first;
                   const Tensor<1, 2> gj = fev.shape_grad(j, q);
@@ -110,7 +131,7 @@ namespace knee_contact
             }
         }
 
-      if (material.reduced_volumetric)
+      if (with_matrix && material.reduced_volumetric)
         {
           scratch.fe_values_reduced.reinit(cell);
           const FEValues<2> &fer = scratch.fe_values_reduced;
@@ -152,8 +173,9 @@ namespace knee_contact
               }
     };
 
-    const auto copier = [&matrix, &rhs](const CopyData &copy) {
-      matrix.add(copy.dof_indices, copy.cell_matrix);
+    const auto copier = [matrix, &rhs](const CopyData &copy) {
+      if (matrix != nullptr)
+        matrix->add(copy.dof_indices, copy.cell_matrix);
       rhs.add(copy.dof_indices, copy.cell_rhs);
     };
 

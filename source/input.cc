@@ -101,7 +101,8 @@ namespace knee_contact
     parse_expression(const std::string &expression,
                      const unsigned int n_components,
                      const std::string &parameter,
-                     const std::string &constants)
+                     const std::string &constants,
+                     const bool         load)
     {
       const auto parts = split(expression, ';');
       AssertThrow(parts.size() == n_components,
@@ -135,18 +136,27 @@ namespace knee_contact
       Vector<double> values(n_components);
       try
         {
-          function->initialize("x,y", parts, constant_map);
+          function->initialize(load ? "x,y,t" : "x,y",
+                               parts,
+                               constant_map,
+                               load);
           function->vector_value(Point<2>(0.123456789, 0.234567891), values);
           std::cerr.rdbuf(cerr_buffer);
         }
       catch (const std::exception &exc)
         {
           std::cerr.rdbuf(cerr_buffer);
+          const std::string what = one_line(exc.what());
           AssertThrow(false,
-                      ExcMessage("parameter '" + parameter +
-                                 "': cannot evaluate expression '" +
-                                 expression + "' (" + one_line(exc.what()) +
-                                 ")"));
+                      ExcMessage(
+                        "parameter '" + parameter +
+                        "': cannot evaluate expression '" + expression + "' (" +
+                        what + ")" +
+                        (!load && what.find("\"t\"") != std::string::npos
+                           ? "; the load parameter t may only appear in "
+                             "traction, pressure, body force and "
+                             "exact-solution expressions"
+                           : "")));
         }
       // A value that is not finite at a generic point is a mistake (1/0,
       // log(0)), not a singularity the scene means.

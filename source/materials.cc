@@ -148,7 +148,9 @@ namespace knee_contact
         material.body_force =
           input::parse_expression(prm.get("Body force"),
                                   2,
-                                  "Materials/" + section + "/Body force");
+                                  "Materials/" + section + "/Body force",
+                                  "",
+                                  true);
         prm.leave_subsection();
       }
     prm.leave_subsection();
@@ -214,5 +216,13 @@ namespace knee_contact
     for (const auto &m : materials)
       E = std::max(E, m.second.youngs_modulus);
     return E;
+  }
+
+
+  void
+  Materials::set_load_parameter(const double t)
+  {
+    for (auto &m : materials)
+      m.second.body_force->set_time(t);
   }
 } // namespace knee_contact

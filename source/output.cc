@@ -221,7 +221,34 @@ namespace knee_contact
   OutputWriter::staging(const std::string &name) const
   {
     Assert(result_folder, ExcInternalError());
-    return result_folder->staging() + "/" + name;
+    return result_folder->staging() + "/" + subfolder + name;
+  }
+
+
+
+  std::string
+  OutputWriter::final_path(const std::string &name) const
+  {
+    return output_folder + "/" + subfolder + name;
+  }
+
+
+
+  void
+  OutputWriter::set_subfolder(const std::string &name)
+  {
+    subfolder.clear();
+    if (!write_files)
+      return;
+    if (!name.empty())
+      {
+        std::error_code error;
+        std::filesystem::create_directory(staging(name), error);
+        AssertThrow(!error,
+                    ExcMessage("cannot create the folder '" + final_path(name) +
+                               "': " + error.message()));
+        subfolder = name + "/";
+      }
   }
 
 
@@ -279,7 +306,7 @@ namespace knee_contact
     flags.compression_level = DataOutBase::VtkFlags::best_speed;
     data_out.set_flags(flags);
     write_checked(staging("solution.vtu"),
-                  output_folder + "/" + "solution.vtu",
+                  final_path("solution.vtu"),
                   [&](std::ostream &out) { data_out.write_vtu(out); });
   }
 
@@ -315,7 +342,7 @@ namespace knee_contact
           }
       }
     write_checked(staging("cells.npy"),
-                  output_folder + "/cells.npy",
+                  final_path("cells.npy"),
                   [&](std::ostream &out) {
                     std::string header =
                       "{'descr': '<f4', 'fortran_order': False, "
@@ -345,7 +372,7 @@ namespace knee_contact
     const std::string                         &name,
     const std::function<void(std::ostream &)> &write) const
   {
-    write_checked(staging(name), output_folder + "/" + name, write);
+    write_checked(staging(name), final_path(name), write);
   }
 
 
@@ -365,11 +392,11 @@ namespace knee_contact
         return false;
       }
     // An argument vector, no shell: the folder name is data.
-    const std::string   log = staging("pictures.log");
-    const ProgramResult result =
-      run_program({"/usr/bin/python3", script, result_folder->staging()},
-                  log,
-                  picture_time_limit);
+    const std::string   log    = staging("pictures.log");
+    const ProgramResult result = run_program(
+      {"/usr/bin/python3", script, result_folder->staging() + "/" + subfolder},
+      log,
+      picture_time_limit);
     std::filesystem::remove(log);
     if (result.exit_code == 0)
       return true;
@@ -412,27 +439,26 @@ namespace knee_contact
           return pairs[a].position[axis] < pairs[b].position[axis];
         });
         const std::string name = csv_file_name(interfaces.interfaces()[i].name);
-        write_checked(
-          staging(name), output_folder + "/" + name, [&](std::ostream &out) {
-            // The discretisation in every row, so that a CSV read on its
-            // own says how its pressure was computed.
-            out << "arc_length,x,y,n_x,n_y,gap,jump,pressure,active,"
-                   "discretisation\n"
-                << std::setprecision(10);
-            double s = 0;
-            for (unsigned int k = 0; k < order.size(); ++k)
-              {
-                const ContactPair &pair = pairs[order[k]];
-                if (k > 0)
-                  s += pair.position.distance(pairs[order[k - 1]].position);
-                out << s << ',' << pair.position[0] << ',' << pair.position[1]
-                    << ',' << pair.normal[0] << ',' << pair.normal[1] << ','
-                    << pair.gap << ',' << pair.jump(solution) << ','
-                    << results.pressure[order[k]] << ','
-                    << (contact.active[order[k]] ? 1 : 0) << ','
-                    << pairing_name(results.interfaces[i].pairing) << '\n';
-              }
-          });
+        write_checked(staging(name), final_path(name), [&](std::ostream &out) {
+          // The discretisation in every row, so that a CSV read on its
+          // own says how its pressure was computed.
+          out << "arc_length,x,y,n_x,n_y,gap,jump,pressure,active,"
+                 "discretisation\n"
+              << std::setprecision(10);
+          double s = 0;
+          for (unsigned int k = 0; k < order.size(); ++k)
+            {
+              const ContactPair &pair = pairs[order[k]];
+              if (k > 0)
+                s += pair.position.distance(pairs[order[k - 1]].position);
+              out << s << ',' << pair.position[0] << ',' << pair.position[1]
+                  << ',' << pair.normal[0] << ',' << pair.normal[1] << ','
+                  << pair.gap << ',' << pair.jump(solution) << ','
+                  << results.pressure[order[k]] << ','
+                  << (contact.active[order[k]] ? 1 : 0) << ','
+                  << pairing_name(results.interfaces[i].pairing) << '\n';
+            }
+        });
       }
   }
 
@@ -500,7 +526,7 @@ namespace knee_contact
     for (const auto &[name, value] : solver_figures)
       summary["solver"][name] = value;
     write_checked(staging("summary.json"),
-                  output_folder + "/" + "summary.json",
+                  final_path("summary.json"),
                   [&](std::ostream &out) { out << summary.dump(2) << '\n'; });
   }
 } // namespace knee_contact

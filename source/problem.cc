@@ -5,6 +5,7 @@
 #include <knee_contact/scene_checks.h>
 #include <knee_contact/scene_file.h>
 
+#include <deal.II/base/data_out_base.h>
 #include <deal.II/base/timer.h>
 #include <deal.II/base/utilities.h>
 
@@ -94,6 +95,7 @@ namespace knee_contact
     BoundaryConditions::declare_parameters(prm, counts.n_conditions);
     ContactInterfaces::declare_parameters(prm, counts.n_interfaces);
     ActiveSetSolver::declare_parameters(prm);
+    LoadCases::declare_parameters(prm);
     OutputWriter::declare_parameters(prm);
     Verification::declare_parameters(prm);
     Refinement::declare_parameters(prm);
@@ -128,6 +130,7 @@ namespace knee_contact
     boundary_conditions.parse_parameters(prm, counts.n_conditions);
     contact_interfaces.parse_parameters(prm, counts.n_interfaces);
     active_set_solver.parse_parameters(prm, materials.max_youngs_modulus());
+    load_cases.parse_parameters(prm);
     output_writer.parse_parameters(prm, scene_file);
     verification.parse_parameters(prm);
     refinement.parse_parameters(prm);
@@ -255,121 +258,17 @@ namespace knee_contact
           assembler.assemble(dof_handler, system_matrix, system_rhs);
         });
         timed("solve", [&]() {
-          const RigidModes rigid_modes(dof_handler, body_of_cell, body_names);
           // Warm start on a refined mesh: pairs within the previous contact
           // zone start active (the loop corrects the guess).
-          std::vector<bool> guess(contact_pairs.size(), false);
+          std::vector<bool> guess;
+          if (cycle > 0)
+            guess.assign(contact_pairs.size(), false);
           if (cycle > 0)
             for (unsigned int p = 0; p < contact_pairs.size(); ++p)
               for (const auto &[position, length] : previous_contact)
                 if (contact_pairs[p].position.distance(position) <= length)
                   guess[p] = true;
-          std::ostream &loop_log = contact_pairs.empty() ? quiet : std::cout;
-          try
-            {
-              solver_figures.clear();
-              Timer                          clock;
-              std::unique_ptr<ContactSystem> system;
-              CondensedContactSystem        *condensed = nullptr;
-              if (active_set_solver.linear_solver() ==
-                  ActiveSetSolver::LinearSolver::condensed)
-                try
-                  {
-                    auto made =
-                      std::make_unique<CondensedContactSystem>(system_matrix,
-                                                               constraints,
-                                                               contact_pairs);
-                    made->set_rhs(system_rhs);
-                    condensed = made.get();
-                    system    = std::move(made);
-                  }
-                catch (const CondensedContactSystem::ExcNotPositiveDefinite &)
-                  {
-                    // A body held by fewer contact unknowns than its rigid
-                    // motions (e.g. a single contact vertex) leaves C_ii
-                    // singular; the full path constrains before factorising.
-                    loop_log << "   the interior of a body is not held "
-                                "without its contact rows: using the step-41 "
-                                "solver"
-                             << std::endl;
-                  }
-              if (!system)
-                system = std::make_unique<FullContactSystem>(system_matrix,
-                                                             system_rhs,
-                                                             constraints,
-                                                             contact_pairs);
-              solver_name = condensed ? "condensed" : "step-41";
-              contact_solution =
-                active_set_solver.solve(*system,
-                                        system_rhs.linfty_norm(),
-                                        constraints,
-                                        contact_pairs,
-                                        rigid_modes,
-                                        guess,
-                                        loop_log);
-              system->solution(displacement);
-              solver_figures["contact_solve"] = clock.wall_time();
-              if (condensed)
-                {
-                  const auto &t = condensed->timings();
-                  solver_figures["contact_unknowns"] =
-                    condensed->n_contact_unknowns();
-                  solver_figures["ordering"]         = t.ordering;
-                  solver_figures["factorisation"]    = t.factorisation;
-                  solver_figures["schur_complement"] = t.schur;
-                  solver_figures["condensation"]     = t.condensation;
-                  solver_figures["active_set_loop"]  = t.dense;
-                  solver_figures["expansion"]        = t.expansion;
-                }
-              if (active_set_solver.measure_reference())
-                {
-                  Vector<double> x;
-                  solver_figures["reference_solve"] =
-                    reference_solve(system_matrix,
-                                    system_rhs,
-                                    constraints,
-                                    contact_pairs,
-                                    contact_solution.active,
-                                    x);
-                  x -= displacement;
-                  solver_figures["reference_difference"] =
-                    x.linfty_norm() /
-                    std::max(displacement.linfty_norm(), 1e-300);
-                }
-            }
-          catch (const CondensedContactSystem::ExcNotPositiveDefinite &)
-            {
-              AssertThrow(false,
-                          ExcMessage("the stiffness matrix is singular "
-                                     "under the active contact rows; check "
-                                     "that every body is held"));
-            }
-          catch (const SparseDirectUMFPACK::ExcUMFPACKError &exc)
-            {
-              // UMFPACK's status: 1 singular, -1 out of memory.
-              std::ostringstream info;
-              exc.print_info(info);
-              const bool memory =
-                info.str().find("status -1") != std::string::npos;
-              if (memory)
-                throw std::bad_alloc();
-              AssertThrow(false,
-                          ExcMessage("UMFPACK: the stiffness matrix is "
-                                     "singular; check that every body is "
-                                     "held"));
-            }
-          // Finite data and moduli were checked; a non-finite solution
-          // means they are too extreme together for double precision.
-          for (const double u : displacement)
-            AssertThrow(std::isfinite(u),
-                        ExcMessage(
-                          "the solution is not finite: the loads and "
-                          "displacements are too large for the moduli "
-                          "(E from " +
-                          std::to_string(materials.min_youngs_modulus()) +
-                          " to " +
-                          std::to_string(materials.max_youngs_modulus()) +
-                          " Pa); choose units that keep them near 1"));
+          solve_contact(guess, true);
         });
         timed("postprocess", [&]() {
           results       = compute_results(dof_handler,
@@ -417,11 +316,297 @@ namespace knee_contact
 
 
 
+  void
+  ContactProblem::solve_contact(const std::vector<bool> &guess,
+                                const bool               new_matrix)
+  {
+    const RigidModes rigid_modes(dof_handler, body_of_cell, body_names);
+    std::ostream    &loop_log = contact_pairs.empty() ? quiet : std::cout;
+    try
+      {
+        Timer clock;
+        if (new_matrix)
+          {
+            solver_figures.clear();
+            contact_system.reset();
+            condensed_system = nullptr;
+            if (active_set_solver.linear_solver() ==
+                ActiveSetSolver::LinearSolver::condensed)
+              try
+                {
+                  auto made =
+                    std::make_unique<CondensedContactSystem>(system_matrix,
+                                                             constraints,
+                                                             contact_pairs);
+                  condensed_system = made.get();
+                  contact_system   = std::move(made);
+                }
+              catch (const CondensedContactSystem::ExcNotPositiveDefinite &)
+                {
+                  // A body held by fewer contact unknowns than its rigid
+                  // motions (e.g. a single contact vertex) leaves C_ii
+                  // singular; the full path constrains before factorising.
+                  loop_log << "   the interior of a body is not held "
+                              "without its contact rows: using the step-41 "
+                              "solver"
+                           << std::endl;
+                }
+            if (!contact_system)
+              contact_system =
+                std::make_unique<FullContactSystem>(system_matrix,
+                                                    constraints,
+                                                    contact_pairs);
+            solver_name = condensed_system ? "condensed" : "step-41";
+          }
+        contact_system->set_rhs(system_rhs);
+        contact_solution = active_set_solver.solve(*contact_system,
+                                                   system_rhs.linfty_norm(),
+                                                   constraints,
+                                                   contact_pairs,
+                                                   rigid_modes,
+                                                   guess,
+                                                   loop_log);
+        contact_system->solution(displacement);
+        solver_figures["contact_solve"] = clock.wall_time();
+        if (condensed_system)
+          {
+            const auto &t = condensed_system->timings();
+            solver_figures["contact_unknowns"] =
+              condensed_system->n_contact_unknowns();
+            solver_figures["ordering"]         = t.ordering;
+            solver_figures["factorisation"]    = t.factorisation;
+            solver_figures["schur_complement"] = t.schur;
+            solver_figures["condensation"]     = t.condensation;
+            solver_figures["active_set_loop"]  = t.dense;
+            solver_figures["expansion"]        = t.expansion;
+          }
+        if (new_matrix && active_set_solver.measure_reference())
+          {
+            Vector<double> x;
+            solver_figures["reference_solve"] =
+              reference_solve(system_matrix,
+                              system_rhs,
+                              constraints,
+                              contact_pairs,
+                              contact_solution.active,
+                              x);
+            x -= displacement;
+            solver_figures["reference_difference"] =
+              x.linfty_norm() / std::max(displacement.linfty_norm(), 1e-300);
+          }
+      }
+    catch (const CondensedContactSystem::ExcNotPositiveDefinite &)
+      {
+        AssertThrow(false,
+                    ExcMessage("the stiffness matrix is singular "
+                               "under the active contact rows; check "
+                               "that every body is held"));
+      }
+    catch (const SparseDirectUMFPACK::ExcUMFPACKError &exc)
+      {
+        // UMFPACK's status: 1 singular, -1 out of memory.
+        std::ostringstream info;
+        exc.print_info(info);
+        const bool memory = info.str().find("status -1") != std::string::npos;
+        if (memory)
+          throw std::bad_alloc();
+        AssertThrow(false,
+                    ExcMessage("UMFPACK: the stiffness matrix is "
+                               "singular; check that every body is "
+                               "held"));
+      }
+    // Finite data and moduli were checked; a non-finite solution
+    // means they are too extreme together for double precision.
+    for (const double u : displacement)
+      AssertThrow(std::isfinite(u),
+                  ExcMessage("the solution is not finite: the loads and "
+                             "displacements are too large for the moduli "
+                             "(E from " +
+                             std::to_string(materials.min_youngs_modulus()) +
+                             " to " +
+                             std::to_string(materials.max_youngs_modulus()) +
+                             " Pa); choose units that keep them near 1"));
+  }
+
+
+
+  void
+  ContactProblem::set_load_parameter(const double t)
+  {
+    materials.set_load_parameter(t);
+    boundary_conditions.set_load_parameter(t);
+    verification.set_load_parameter(t);
+  }
+
+
+
+  void
+  ContactProblem::write_result_set(
+    const Results                               &results,
+    const std::vector<std::vector<CycleRecord>> &sequences,
+    TimerOutput                                 &timer)
+  {
+    {
+      TimerOutput::Scope scope(timer, "output");
+      output_writer.write_vtu(dof_handler,
+                              body_of_cell,
+                              displacement,
+                              materials,
+                              contact_pairs,
+                              contact_solution,
+                              results);
+      output_writer.write_cells(dof_handler,
+                                body_of_cell,
+                                displacement,
+                                results);
+      output_writer.write_contact_csv(contact_interfaces,
+                                      contact_pairs,
+                                      displacement,
+                                      contact_solution,
+                                      results);
+      if (sequences.size() > 1)
+        output_writer.write_file("study.csv", [&](std::ostream &out) {
+          std::vector<CycleRecord> all;
+          for (const auto &records : sequences)
+            all.insert(all.end(), records.begin(), records.end());
+          write_study_csv(all, out);
+        });
+    }
+    Utilities::System::MemoryStats memory;
+    Utilities::System::get_memory_stats(memory);
+    solver_figures["peak_memory_MB"] = memory.VmHWM / 1024.;
+    // The pictures read summary.json; a picture failure is kept in it
+    // as a warning.
+    const auto summary = [&]() {
+      output_writer.write_summary(results,
+                                  contact_solution,
+                                  materials,
+                                  timer.get_summary_data(
+                                    TimerOutput::total_wall_time),
+                                  solver_name,
+                                  solver_figures);
+    };
+    summary();
+    TimerOutput::Scope scope(timer, "pictures");
+    std::string        message;
+    if (!output_writer.run_script("plot_results.py", message) ||
+        (sequences.size() > 1 &&
+         !output_writer.run_script("plot_study.py", message)))
+      {
+        output_writer.warn("no pictures: " + message);
+        summary();
+      }
+  }
+
+
+
+  unsigned int
+  ContactProblem::run_load_cases(
+    const Results                               &first_results,
+    const std::vector<std::vector<CycleRecord>> &sequences,
+    TimerOutput                                 &timer)
+  {
+    const std::vector<double>     &t = load_cases.values();
+    std::vector<LoadCases::Record> records;
+    const auto                     record = [&](const double   t_case,
+                            const double   solve_time,
+                            const Results &results) {
+      LoadCases::Record r;
+      r.t            = t_case;
+      r.n_iterations = contact_solution.n_iterations;
+      r.converged    = contact_solution.converged;
+      r.solve_time   = solve_time;
+      r.results      = results;
+      records.push_back(r);
+    };
+    record(t[0], solver_figures["contact_solve"], first_results);
+    if (output_writer.enabled())
+      {
+        output_writer.set_subfolder(LoadCases::folder(0));
+        write_result_set(first_results, sequences, timer);
+      }
+
+    unsigned int n_failed = 0;
+    for (unsigned int c = 1; c < t.size() && contact_solution.converged; ++c)
+      {
+        std::cout << "load case " << c << ": t = " << t[c] << std::endl;
+        set_load_parameter(t[c]);
+        Timer clock;
+        {
+          TimerOutput::Scope scope(timer, "load cases: assembly");
+          ElasticityAssembler(materials, boundary_conditions)
+            .assemble_rhs(dof_handler, system_rhs);
+        }
+        {
+          TimerOutput::Scope scope(timer, "load cases: solve");
+          // The previous case's active set is the guess: loads along a
+          // cycle change little from case to case.
+          solve_contact(contact_solution.active, false);
+        }
+        const double solve_time = clock.wall_time();
+        Results      results;
+        {
+          TimerOutput::Scope scope(timer, "postprocess");
+          results = compute_results(dof_handler,
+                                    body_of_cell,
+                                    system_matrix,
+                                    system_rhs,
+                                    displacement,
+                                    materials,
+                                    boundary_conditions,
+                                    contact_interfaces,
+                                    contact_pairs,
+                                    contact_solution);
+        }
+        print_results(results);
+        const Errors errors = verification.compute_errors(
+          dof_handler, displacement, materials, contact_pairs, results);
+        n_failed += verification.check(results,
+                                       contact_solution,
+                                       !contact_pairs.empty(),
+                                       {errors},
+                                       {double(dof_handler.n_dofs())},
+                                       std::cout);
+        record(t[c], solve_time, results);
+        if (output_writer.enabled())
+          {
+            output_writer.set_subfolder(LoadCases::folder(c));
+            write_result_set(results, {}, timer);
+          }
+      }
+
+    LoadCases::print_table(records, !output_writer.test_mode(), std::cout);
+    if (output_writer.enabled())
+      {
+        output_writer.set_subfolder("");
+        output_writer.write_file("load_cases.csv", [&](std::ostream &out) {
+          LoadCases::write_csv(records, out);
+        });
+        // A ParaView series: open load_cases.pvd and step through t.
+        output_writer.write_file("load_cases.pvd", [&](std::ostream &out) {
+          std::vector<std::pair<double, std::string>> series;
+          for (unsigned int c = 0; c < records.size(); ++c)
+            series.emplace_back(records[c].t,
+                                LoadCases::folder(c) + "/solution.vtu");
+          DataOutBase::write_pvd_record(out, series);
+        });
+        TimerOutput::Scope scope(timer, "pictures");
+        std::string        message;
+        if (!output_writer.run_script("plot_load_cases.py", message))
+          std::cout << "knee_contact: warning: no load-case plot: " << message
+                    << std::endl;
+      }
+    return n_failed;
+  }
+
+
+
   int
   ContactProblem::run()
   {
     TimerOutput timer(log(), TimerOutput::never, TimerOutput::wall_times);
     output_writer.prepare();
+    set_load_parameter(load_cases.values()[0]);
 
     // A study runs the uniform sequence first; the files and checks are
     // those of the last sequence.
@@ -438,77 +623,6 @@ namespace knee_contact
         print_convergence_table(records, !output_writer.test_mode(), std::cout);
 
     print_results(results);
-
-    if (output_writer.enabled())
-      {
-        TimerOutput::Scope scope(timer, "output");
-        output_writer.write_vtu(dof_handler,
-                                body_of_cell,
-                                displacement,
-                                materials,
-                                contact_pairs,
-                                contact_solution,
-                                results);
-        output_writer.write_cells(dof_handler,
-                                  body_of_cell,
-                                  displacement,
-                                  results);
-        output_writer.write_contact_csv(contact_interfaces,
-                                        contact_pairs,
-                                        displacement,
-                                        contact_solution,
-                                        results);
-        if (sequences.size() > 1)
-          output_writer.write_file("study.csv", [&](std::ostream &out) {
-            std::vector<CycleRecord> all;
-            for (const auto &records : sequences)
-              all.insert(all.end(), records.begin(), records.end());
-            write_study_csv(all, out);
-          });
-      }
-    if (output_writer.enabled())
-      {
-        Utilities::System::MemoryStats memory;
-        Utilities::System::get_memory_stats(memory);
-        solver_figures["peak_memory_MB"] = memory.VmHWM / 1024.;
-        // The pictures read summary.json; a picture failure is kept in it
-        // as a warning.
-        output_writer.write_summary(results,
-                                    contact_solution,
-                                    materials,
-                                    timer.get_summary_data(
-                                      TimerOutput::total_wall_time),
-                                    solver_name,
-                                    solver_figures);
-        TimerOutput::Scope scope(timer, "pictures");
-        std::string        message;
-        if (!output_writer.run_script("plot_results.py", message) ||
-            (sequences.size() > 1 &&
-             !output_writer.run_script("plot_study.py", message)))
-          {
-            output_writer.warn("no pictures: " + message);
-            output_writer.write_summary(results,
-                                        contact_solution,
-                                        materials,
-                                        timer.get_summary_data(
-                                          TimerOutput::total_wall_time),
-                                        solver_name,
-                                        solver_figures);
-          }
-      }
-    const auto wall_times =
-      timer.get_summary_data(TimerOutput::total_wall_time);
-    output_writer.commit();
-    if (!output_writer.test_mode())
-      {
-        std::cout << "wall time [s]:";
-        for (const auto &[phase, seconds] : wall_times)
-          std::cout << "  " << phase << " " << std::setprecision(3) << seconds;
-        std::cout << std::endl;
-        if (output_writer.enabled())
-          std::cout << "results in " << output_writer.folder() << "/"
-                    << std::endl;
-      }
 
     std::vector<std::vector<Errors>> errors(sequences.size());
     std::vector<std::vector<double>> n_dofs(sequences.size());
@@ -527,6 +641,26 @@ namespace knee_contact
     if (sequences.size() > 1)
       n_failed += verification.check_study(
         errors[0], n_dofs[0], errors[1], n_dofs[1], std::cout);
+
+    if (load_cases.values().size() > 1)
+      n_failed += run_load_cases(results, sequences, timer);
+    else if (output_writer.enabled())
+      write_result_set(results, sequences, timer);
+
+    const auto wall_times =
+      timer.get_summary_data(TimerOutput::total_wall_time);
+    output_writer.commit();
+    if (!output_writer.test_mode())
+      {
+        std::cout << "wall time [s]:";
+        for (const auto &[phase, seconds] : wall_times)
+          std::cout << "  " << phase << " " << std::setprecision(3) << seconds;
+        std::cout << std::endl;
+        if (output_writer.enabled())
+          std::cout << "results in " << output_writer.folder() << "/"
+                    << std::endl;
+      }
+
     if (!contact_solution.converged)
       {
         std::cerr << "knee_contact: not converged: " << contact_solution.failure

@@ -130,10 +130,10 @@ namespace knee_contact
     const auto optional = [&prm](const std::string &name,
                                  const unsigned int n_components) {
       const std::string text = prm.get(name);
-      return text.empty() ? nullptr
-                          : input::parse_expression(text,
-                                                    n_components,
-                                                    "Verification/" + name);
+      return text.empty()
+               ? nullptr
+               : input::parse_expression(
+                   text, n_components, "Verification/" + name, "", true);
     };
     exact_displacement = optional("Exact displacement", 2);
     exact_stress       = optional("Exact stress", 3);
@@ -514,5 +514,15 @@ namespace knee_contact
                force_tolerance);
       }
     return n_failed;
+  }
+
+
+  void
+  Verification::set_load_parameter(const double t)
+  {
+    for (auto *function :
+         {exact_displacement.get(), exact_stress.get(), exact_pressure.get()})
+      if (function != nullptr)
+        function->set_time(t);
   }
 } // namespace knee_contact

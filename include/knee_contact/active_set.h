@@ -95,8 +95,9 @@ namespace knee_contact
     /**
      * Run the loop on @p system. @p force_scale is |d|_inf (the load
      * scale of the round-off test for unloaded contact). @p guess marks
-     * pairs to start active besides the touching ones (e.g. the contact
-     * zone of a coarser mesh); empty: none. @p log receives one line per
+     * the pairs to start active (the contact zone of a coarser mesh, the
+     * active set of the previous load case); empty: start from the pairs
+     * that touch (g_p <= 0). @p log receives one line per
      * iteration. The solution is then system.solution().
      */
     ContactSolution

@@ -69,6 +69,14 @@ namespace knee_contact
     make_constraints(const DoFHandler<2>       &dof_handler,
                      AffineConstraints<double> &constraints) const;
 
+    /**
+     * Evaluate the tractions and pressures at load parameter @p t from now
+     * on (the displacement conditions do not depend on t: they are part of
+     * the factorised system).
+     */
+    void
+    set_load_parameter(const double t);
+
     const std::vector<BoundaryCondition> &
     conditions() const
     {

@@ -32,6 +32,13 @@ namespace knee_contact
     virtual ~ContactSystem() = default;
 
     /**
+     * A load case: the load vector d of the following solves (the matrix and
+     * the constraints stay). Must be called before the first solve().
+     */
+    virtual void
+    set_rhs(const Vector<double> &rhs) = 0;
+
+    /**
      * Solve with the rows of the pairs marked in @p active as equalities;
      * @p excess receives (A x - g)_p for every pair, @p lambda the
      * multiplier of every active pair (zero for the others).
@@ -71,9 +78,12 @@ namespace knee_contact
      * (ActiveSetSolver::make_sparsity_pattern).
      */
     FullContactSystem(const SparseMatrix<double>      &matrix,
-                      const Vector<double>            &rhs,
                       const AffineConstraints<double> &base,
                       const std::vector<ContactPair>  &pairs);
+
+    /** Keeps a reference to @p rhs. */
+    void
+    set_rhs(const Vector<double> &rhs) override;
 
     void
     solve(const std::vector<bool> &active,
@@ -88,7 +98,7 @@ namespace knee_contact
 
   private:
     const SparseMatrix<double>      &matrix;
-    const Vector<double>            &rhs;
+    const Vector<double>            *rhs = nullptr;
     const AffineConstraints<double> &base;
     const std::vector<ContactPair>  &pairs;
     SparseMatrix<double>             system_matrix;
@@ -138,7 +148,7 @@ namespace knee_contact
      * substitution); must be called before solve().
      */
     void
-    set_rhs(const Vector<double> &rhs);
+    set_rhs(const Vector<double> &rhs) override;
 
     void
     solve(const std::vector<bool> &active,

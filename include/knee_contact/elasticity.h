@@ -36,7 +36,19 @@ namespace knee_contact
              SparseMatrix<double> &matrix,
              Vector<double>       &rhs) const;
 
+    /**
+     * Only the load vector d, for a further load case on the same mesh:
+     * the body forces and tractions at the load parameter last set.
+     */
+    void
+    assemble_rhs(const DoFHandler<2> &dof_handler, Vector<double> &rhs) const;
+
   private:
+    void
+    assemble(const DoFHandler<2>  &dof_handler,
+             SparseMatrix<double> *matrix,
+             Vector<double>       &rhs) const;
+
     const Materials          &materials;
     const BoundaryConditions &boundary_conditions;
   };

@@ -32,13 +32,17 @@ namespace knee_contact
      * Parse @p expression with @p n_components components (separated by ';')
      * in the variables x, y and the constants "pi" and @p constants
      * ("name=value, ..."). Throws an ExcMessage that names @p parameter if the
-     * expression does not parse.
+     * expression does not parse. A @p load expression (traction, pressure,
+     * body force, exact solutions) may also use t, the load parameter of the
+     * scene's load cases (FunctionParser's time, set by set_time()); elsewhere
+     * t is an unknown name and the message says where it is allowed.
      */
     std::unique_ptr<FunctionParser<2>>
     parse_expression(const std::string &expression,
                      const unsigned int n_components,
                      const std::string &parameter,
-                     const std::string &constants = "");
+                     const std::string &constants = "",
+                     const bool         load      = false);
 
     /**
      * Evaluate a constant expression such as "sqrt(0.01*0.5/pi)".

@@ -89,6 +89,12 @@ namespace knee_contact
     double
     min_youngs_modulus() const;
 
+    /**
+     * Evaluate the body forces at load parameter @p t from now on.
+     */
+    void
+    set_load_parameter(const double t);
+
   private:
     std::map<types::material_id, Material> materials;
   };

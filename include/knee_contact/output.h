@@ -88,6 +88,14 @@ namespace knee_contact
     run_script(const std::string &script, std::string &message) const;
 
     /**
+     * Write the following files (and pictures) into the folder @p name of
+     * the result set, created now; "" for the result set itself. Load
+     * cases write one such folder per case.
+     */
+    void
+    set_subfolder(const std::string &name);
+
+    /**
      * Write the file @p name into the run's staging folder.
      */
     void
@@ -135,6 +143,13 @@ namespace knee_contact
     /** The path of @p name in the staging folder. */
     std::string
     staging(const std::string &name) const;
+
+    /** The path @p name will have in the output folder, for messages. */
+    std::string
+    final_path(const std::string &name) const;
+
+    /** "" or the current case's folder with a trailing '/'. */
+    std::string subfolder;
 
     std::unique_ptr<ResultFolder>                 result_folder;
     std::vector<std::string>                      warnings;

@@ -4,6 +4,8 @@
 #include <knee_contact/active_set.h>
 #include <knee_contact/boundary_conditions.h>
 #include <knee_contact/contact.h>
+#include <knee_contact/contact_system.h>
+#include <knee_contact/load_cases.h>
 #include <knee_contact/materials.h>
 #include <knee_contact/mesh.h>
 #include <knee_contact/output.h>
@@ -158,6 +160,39 @@ namespace knee_contact
                TimerOutput               &timer,
                Results                   &results);
 
+    /**
+     * Solve the contact problem for the current system_rhs, from the active
+     * set @p guess: with a new contact system (factorisation) if
+     * @p new_matrix, else reusing the last one (a further load case).
+     */
+    void
+    solve_contact(const std::vector<bool> &guess, const bool new_matrix);
+
+    /** Evaluate loads and exact solutions at load parameter @p t. */
+    void
+    set_load_parameter(const double t);
+
+    /**
+     * The files of one solution into the output writer's current folder:
+     * VTU, cells.npy, contact CSVs, study.csv for a study, summary.json and
+     * pictures.
+     */
+    void
+    write_result_set(const Results                               &results,
+                     const std::vector<std::vector<CycleRecord>> &sequences,
+                     TimerOutput                                 &timer);
+
+    /**
+     * The further load cases on the last mesh, after the first one was
+     * solved with @p first_results; writes one result set per case,
+     * load_cases.csv, load_cases.pvd and the load-case plot. Returns the
+     * number of failed verification checks.
+     */
+    unsigned int
+    run_load_cases(const Results                               &first_results,
+                   const std::vector<std::vector<CycleRecord>> &sequences,
+                   TimerOutput                                 &timer);
+
     std::ostream &
     log() const;
 
@@ -175,6 +210,7 @@ namespace knee_contact
     BoundaryConditions boundary_conditions;
     ContactInterfaces  contact_interfaces;
     ActiveSetSolver    active_set_solver;
+    LoadCases          load_cases;
     OutputWriter       output_writer;
     Verification       verification;
     Refinement         refinement;
@@ -193,6 +229,9 @@ namespace knee_contact
     Vector<double>            system_rhs;
     Vector<double>            displacement;
     ContactSolution           contact_solution;
+    /** The last cycle's factorised system, kept for further load cases. */
+    std::unique_ptr<ContactSystem> contact_system;
+    CondensedContactSystem        *condensed_system = nullptr;
     /**
      * The last solve's solver figures for summary.json: phase times [s],
      * number of contact unknowns, reference solve (see ActiveSetSolver).

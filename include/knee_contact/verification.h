@@ -101,6 +101,13 @@ namespace knee_contact
           std::ostream              &out) const;
 
 
+    /**
+     * Evaluate the exact solutions at load parameter @p t from now on (they
+     * may depend on t like the loads).
+     */
+    void
+    set_load_parameter(const double t);
+
   private:
     std::unique_ptr<FunctionParser<2>>          exact_displacement;
     std::unique_ptr<FunctionParser<2>>          exact_stress;

@@ -1,0 +1,64 @@
+#!/usr/bin/python3
+"""Picture of a knee_contact load-case run (Load cases/Values of t), from
+FOLDER/load_cases.csv:
+  load_cases.png   against the load parameter t: peak contact pressure and
+                   contact length of every interface, the applied load and
+                   the reaction of every Gamma_u/Gamma_o boundary id.
+Usage: plot_load_cases.py FOLDER
+"""
+import csv
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def main():
+    folder = sys.argv[1]
+    with open(os.path.join(folder, "load_cases.csv")) as f:
+        rows = list(csv.DictReader(f))
+    if not rows:
+        raise SystemExit("load_cases.csv has no cases")
+    columns = list(rows[0].keys())
+    t = [float(r["t"]) for r in rows]
+    interfaces = [c[: -len("_peak_pressure")] for c in columns
+                  if c.endswith("_peak_pressure")]
+    reactions = sorted({c[len("reaction_"):].rsplit("_", 1)[0]
+                        for c in columns if c.startswith("reaction_")},
+                       key=lambda s: int(s))
+
+    figure, axes = plt.subplots(3, 1, figsize=(7, 9), sharex=True)
+    for name in interfaces:
+        axes[0].plot(t, [float(r[name + "_peak_pressure"]) / 1e6
+                         for r in rows], "o-", ms=3, label=name)
+        axes[1].plot(t, [float(r[name + "_contact_length"]) * 1e3
+                         for r in rows], "o-", ms=3, label=name)
+    axes[0].set_ylabel("peak contact pressure [MPa]")
+    axes[1].set_ylabel("contact length [mm]")
+    for component, style in (("y", "-"), ("x", "--")):
+        axes[2].plot(t, [float(r["load_" + component]) / 1e3 for r in rows],
+                     "k" + style, label="applied load " + component)
+        for b in reactions:
+            axes[2].plot(t, [float(r["reaction_%s_%s" % (b, component)]) / 1e3
+                             for r in rows], style, marker="o", ms=3,
+                         label="reaction id %s %s" % (b, component))
+    axes[2].set_ylabel("force [kN/m]")
+    axes[2].set_xlabel("load parameter t")
+    for a in axes:
+        a.grid(True, alpha=0.3)
+        a.legend(fontsize=7)
+    not_converged = [float(r["t"]) for r in rows if r["converged"] != "true"]
+    if not_converged:
+        axes[0].set_title("NOT converged at t = %s" % not_converged)
+    path = os.path.join(folder, "load_cases.png")
+    temporary = path + ".part.png"
+    figure.savefig(temporary, dpi=150, bbox_inches="tight")
+    plt.close(figure)
+    os.replace(temporary, path)
+
+
+if __name__ == "__main__":
+    main()
