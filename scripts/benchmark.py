@@ -2,7 +2,7 @@
 """Speed of the contact solve against one linear solve, per mesh size.
 
     python3 scripts/benchmark.py build/knee_contact [--max-dofs 1.8e6]
-        [--step41-max-dofs 5e5] [--repeat 1] [--scenes hertz,knee]
+        [--step41-max-dofs 5e5] [--repeat 1] [--scenes hertz,knee,gait]
 
 For every scene (Hertz, prm/hertz.prm with lc_fine 0.02, lc_coarse 0.1; the
 sagittal knee, prm/knee.prm) and every number of global refinements up to
@@ -19,9 +19,17 @@ repeated and every figure is the median.
 Printed: one table per scene (times in seconds, memory = peak resident set
 of the run per dof) and the exponent b of a least-squares fit time = a n^b
 over the sizes >= 1e4 dofs. Pictures are off; output is the VTU and CSVs.
+
+Scene "gait" (prm/knee_gait.prm with 11 load cases t = 0:0.1:1) measures
+load cases: per size the first case (assembly and contact solve), the
+median further case (load vector assembly, condensation, active-set loop
+from the previous case's set, back substitution: solve_time of
+load_cases.csv), their ratio, the median iterations of the further cases,
+and the output (VTU, CSVs, summary) per case.
 """
 
 import argparse
+import csv
 import json
 import math
 import os
@@ -37,6 +45,8 @@ SCENES = {
               {(("Mesh",), "Gmsh arguments"):
                "-setnumber lc_fine 0.02 -setnumber lc_coarse 0.1"}),
     "knee": ("prm/knee.prm", {}),
+    "gait": ("prm/knee_gait.prm", {(("Load cases",), "Values of t"):
+                                   "0:0.1:1"}),
 }
 
 
@@ -77,7 +87,7 @@ def set_entries(text, scene_dir, changes):
     return "\n".join(out) + "\n"
 
 
-def run(program, scene, changes, work):
+def run(program, scene, changes, work, result="summary.json"):
     scene_path = os.path.join(ROOT, scene)
     changes = dict(changes)
     folder = os.path.join(work, "out")
@@ -93,7 +103,37 @@ def run(program, scene, changes, work):
     if done.returncode != 0:
         sys.exit("benchmark: %s failed (exit %d):\n%s" %
                  (scene, done.returncode, done.stdout[-2000:]))
-    return json.load(open(os.path.join(folder, "summary.json")))
+    if result.endswith(".csv"):
+        with open(os.path.join(folder, result)) as f:
+            rows = list(csv.DictReader(f))
+        return rows, json.load(open(os.path.join(
+            folder, "case_%03d" % (len(rows) - 1), "summary.json")))
+    return json.load(open(os.path.join(folder, result)))
+
+
+def gait_benchmark(program, args):
+    scene, base = SCENES["gait"]
+    print("\ngait (%s, t = 0:0.1:1)" % scene)
+    print("| dofs | first case [s] | further case [s] | ratio | "
+          "further iterations | output per case [s] |")
+    print("|---|---|---|---|---|---|")
+    with tempfile.TemporaryDirectory(prefix="benchmark-") as work:
+        for level in range(10):
+            changes = dict(base)
+            changes[("Mesh",), "Global refinements"] = str(level)
+            cases, last = run(program, scene, changes, work,
+                              "load_cases.csv")
+            wall = last["wall_time"]
+            first = wall.get("assembly", 0) + float(cases[0]["solve_time"])
+            further = statistics.median(float(c["solve_time"])
+                                        for c in cases[1:])
+            iterations = statistics.median(int(c["iterations"])
+                                           for c in cases[1:])
+            print("| %d | %.3g | %.3g | %.3f | %g | %.3g |" % (
+                last["n_dofs"], first, further, further / first, iterations,
+                wall.get("output", 0) / len(cases)), flush=True)
+            if 4 * last["n_dofs"] > args.max_dofs:
+                break
 
 
 def median_run(program, scene, changes, work, repeat):
@@ -144,6 +184,9 @@ def main():
     program = os.path.abspath(args.program)
 
     for name in args.scenes.split(","):
+        if name == "gait":
+            gait_benchmark(program, args)
+            continue
         scene, base = SCENES[name]
         rows = []
         with tempfile.TemporaryDirectory(prefix="benchmark-") as work:

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <new>
 #include <set>
@@ -376,6 +377,30 @@ namespace knee_contact
     std::vector<double> x_c;     // contact unknowns of the last solve
     Timings             timings;
 
+    /**
+     * The loop in multiplier space (set_up_multiplier_loop()): the pairs
+     * with a row (q = 0..P-1), rho, the Cholesky factor of
+     * S~ = S + rho B^T B (B: every pair's row), W = S~^-1 B^T (k x P),
+     * G = B W (P x P), and per load case u0 = S~^-1 f and h = B u0.
+     */
+    bool                      multiplier_loop = false;
+    std::vector<unsigned int> row_pairs;
+    double                    rho = 0;
+    std::vector<double>       s_tilde;
+    std::vector<double>       w;
+    std::vector<double>       g;
+    std::vector<double>       u0;
+    std::vector<double>       h;
+
+    void
+    set_up_multiplier_loop();
+
+    bool
+    solve_by_multipliers(const std::vector<bool> &active);
+
+    void
+    solve_by_elimination(const std::vector<bool> &active);
+
     Implementation(const SparseMatrix<double>      &matrix,
                    const AffineConstraints<double> &base,
                    const std::vector<ContactPair>  &pairs)
@@ -432,6 +457,130 @@ namespace knee_contact
     d.l_cc              = d.cholesky.trailing_block(k);
     d.s                 = product_with_transpose(d.l_cc, k, d.shift);
     d.timings.schur     = clock.wall_time();
+
+    clock.restart();
+    d.set_up_multiplier_loop();
+    d.timings.loop_setup = clock.wall_time();
+  }
+
+
+
+  void
+  CondensedContactSystem::Implementation::set_up_multiplier_loop()
+  {
+    // Why by hand: the loop needs the KKT system of S with the active rows
+    // for a new active set in every iteration, at less than one dense
+    // factorisation each. With S~ = S + rho B^T B over the rows of all P
+    // pairs, S = S~ - rho B_A^T B_A - rho B_I^T B_I, and the KKT system
+    //   S x + B_A^T lambda = f,  B_A x = g_A
+    // becomes, with z_A = lambda - rho g_A and z_I = -rho (B_I x),
+    //   x = S~^-1 f - W z,  (G - D_I / rho) z = h - g_A,
+    // W = S~^-1 B^T, G = B W, h = B S~^-1 f, D_I the inactive diagonal.
+    // S~ and W are made once per mesh (S~ is regular even where S is not:
+    // a body held only by contact is held by the rows of all pairs), each
+    // iteration solves a P x P system (P = number of pairs, a fraction of
+    // k), and each load case costs two triangular solves with S~.
+    const std::size_t k = dofs.size();
+    row_pairs.clear();
+    for (unsigned int p = 0; p < pairs.size(); ++p)
+      if (pairs[p].eliminated != numbers::invalid_dof_index)
+        row_pairs.push_back(p);
+    const std::size_t n_rows = row_pairs.size();
+    if (k == 0 || n_rows == 0)
+      return;
+    double s_max = 0, a_max = 0;
+    for (std::size_t i = 0; i < k; ++i)
+      s_max = std::max(s_max, s[i * k + i]);
+    for (const unsigned int p : row_pairs)
+      {
+        double norm = 0;
+        for (const auto &[l, a] : rows[p])
+          norm += a * a;
+        a_max = std::max(a_max, norm);
+      }
+    if (!(s_max > 0 && a_max > 0))
+      return;
+    rho     = s_max / a_max;
+    s_tilde = s;
+    for (const unsigned int p : row_pairs)
+      for (const auto &[i, a_i] : rows[p])
+        for (const auto &[j, a_j] : rows[p])
+          s_tilde[std::size_t(j) * k + i] += rho * a_i * a_j;
+    const types::blas_int n    = k;
+    types::blas_int       info = 0;
+    potrf("L", &n, s_tilde.data(), &n, &info);
+    if (info != 0)
+      return;
+    // A pivot at round-off of the largest diagonal entry: S~ is singular in
+    // all but round-off (a body free even with every pair closed); the
+    // elimination path and the rigid-mode diagnostics handle that.
+    double pivot_min = std::numeric_limits<double>::max();
+    for (std::size_t i = 0; i < k; ++i)
+      pivot_min = std::min(pivot_min, s_tilde[i * k + i] * s_tilde[i * k + i]);
+    if (pivot_min < 1e-10 * (s_max + rho * a_max))
+      return;
+
+    w.assign(k * n_rows, 0.);
+    for (std::size_t q = 0; q < n_rows; ++q)
+      for (const auto &[l, a] : rows[row_pairs[q]])
+        w[q * k + l] += a;
+    const types::blas_int n_rhs = n_rows;
+    potrs("L", &n, &n_rhs, s_tilde.data(), &n, w.data(), &n, &info);
+    AssertThrow(info == 0, ExcInternalError());
+    g.assign(n_rows * n_rows, 0.);
+    for (std::size_t c = 0; c < n_rows; ++c)
+      for (std::size_t q = 0; q < n_rows; ++q)
+        {
+          double sum = 0;
+          for (const auto &[l, a] : rows[row_pairs[q]])
+            sum += a * w[c * k + l];
+          g[c * n_rows + q] = sum;
+        }
+    multiplier_loop = true;
+  }
+
+
+
+  bool
+  CondensedContactSystem::Implementation::solve_by_multipliers(
+    const std::vector<bool> &active)
+  {
+    const std::size_t   k = dofs.size(), n_rows = row_pairs.size();
+    std::vector<double> m = g, z(n_rows);
+    for (std::size_t q = 0; q < n_rows; ++q)
+      {
+        const unsigned int p = row_pairs[q];
+        if (active[p])
+          z[q] = h[q] - pairs[p].reduced_gap;
+        else
+          {
+            z[q] = h[q];
+            m[q * n_rows + q] -= 1. / rho;
+          }
+      }
+    const types::blas_int        n = n_rows, one = 1;
+    types::blas_int              info = 0;
+    std::vector<types::blas_int> pivots(n_rows);
+    getrf(&n, &n, m.data(), &n, pivots.data(), &info);
+    if (info != 0)
+      return false;
+    getrs("N", &n, &one, m.data(), &n, pivots.data(), z.data(), &n, &info);
+    AssertThrow(info == 0, ExcInternalError());
+    x_c                          = u0;
+    const types::blas_int rows_k = k, columns = n_rows;
+    const double          minus_one = -1, plus_one = 1;
+    gemv("N",
+         &rows_k,
+         &columns,
+         &minus_one,
+         w.data(),
+         &rows_k,
+         z.data(),
+         &one,
+         &plus_one,
+         x_c.data(),
+         &one);
+    return true;
   }
 
 
@@ -472,18 +621,29 @@ namespace knee_contact
     for (std::size_t j = 0; j < k; ++j)
       for (std::size_t i = j; i < k; ++i)
         d.f[i] += d.l_cc[j * k + i] * d.forward[n - k + j];
+    if (d.multiplier_loop)
+      {
+        d.u0                      = d.f;
+        const types::blas_int n_k = k, one = 1;
+        types::blas_int       info = 0;
+        potrs(
+          "L", &n_k, &one, d.s_tilde.data(), &n_k, d.u0.data(), &n_k, &info);
+        AssertThrow(info == 0, ExcInternalError());
+        d.h.assign(d.row_pairs.size(), 0.);
+        for (std::size_t q = 0; q < d.row_pairs.size(); ++q)
+          for (const auto &[l, a] : d.rows[d.row_pairs[q]])
+            d.h[q] += a * d.u0[l];
+      }
     d.timings.condensation += clock.wall_time();
   }
 
 
 
   void
-  CondensedContactSystem::solve(const std::vector<bool> &active,
-                                std::vector<double>     &excess,
-                                std::vector<double>     &lambda)
+  CondensedContactSystem::Implementation::solve_by_elimination(
+    const std::vector<bool> &active)
   {
-    Implementation   &d = *implementation;
-    Timer             clock;
+    Implementation   &d = *this;
     const std::size_t k = d.dofs.size();
     // The active rows, each solved for its eliminated dof, as constraints
     // on the local indices; close() resolves chains (a row whose
@@ -565,6 +725,20 @@ namespace knee_contact
         for (const auto &[a, c] : t_of[l])
           d.x_c[l] += c * y[a];
       }
+  }
+
+
+
+  void
+  CondensedContactSystem::solve(const std::vector<bool> &active,
+                                std::vector<double>     &excess,
+                                std::vector<double>     &lambda)
+  {
+    Implementation   &d = *implementation;
+    Timer             clock;
+    const std::size_t k = d.dofs.size();
+    if (!d.multiplier_loop || !d.solve_by_multipliers(active))
+      d.solve_by_elimination(active);
 
     // Multipliers from the condensed residual r_c = f - S x_c, which is
     // A'^T lambda on the contact unknowns.

@@ -376,6 +376,7 @@ namespace knee_contact
             solver_figures["ordering"]         = t.ordering;
             solver_figures["factorisation"]    = t.factorisation;
             solver_figures["schur_complement"] = t.schur;
+            solver_figures["loop_setup"]       = t.loop_setup;
             solver_figures["condensation"]     = t.condensation;
             solver_figures["active_set_loop"]  = t.dense;
             solver_figures["expansion"]        = t.expansion;

@@ -172,6 +172,8 @@ namespace knee_contact
       double ordering      = 0;
       double factorisation = 0;
       double schur         = 0;
+      /** S~ = S + rho B^T B, its factor, W and G (multiplier loop). */
+      double loop_setup    = 0;
       double condensation  = 0;
       double dense         = 0;
       double expansion     = 0;
