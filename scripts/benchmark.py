@@ -155,7 +155,8 @@ def median_run(program, scene, changes, work, repeat):
         "memory": median(lambda r: r["solver"]["peak_memory_MB"]),
     }
     for phase in ["ordering", "factorisation", "schur_complement",
-                  "active_set_loop", "expansion"]:
+                  "loop_setup", "active_set_loop", "expansion",
+                  "factor_memory_MB", "dense_memory_MB"]:
         figures[phase] = median(lambda r: r["solver"].get(phase, 0))
     for phase in ["setup", "assembly", "output"]:
         figures[phase] = median(lambda r: r["wall_time"].get(phase, 0))
@@ -213,22 +214,24 @@ def main():
         print("\n%s (%s), median of %d run(s)" % (name, scene, args.repeat))
         header = ("dofs", "pairs", "k", "it", "one solve", "contact",
                   "ratio", "step-41", "speed-up", "order", "factor", "Schur",
-                  "loop", "expand", "setup", "assembly", "output",
-                  "kB/dof")
+                  "loop set-up", "loop", "expand", "setup", "assembly",
+                  "output", "kB/dof", "factor kB/dof", "dense kB/dof")
         print("| " + " | ".join(header) + " |")
         print("|" + "---|" * len(header))
         for r in rows:
             print("| %d | %d | %d | %d | %.3g | %.3g | %.2f | %.3g | %.1f | "
                   "%.3g | %.3g | %.3g | %.3g | %.3g | %.3g | %.3g | %.3g | "
-                  "%.2f |" % (
+                  "%.3g | %.2f | %.2f | %.2f |" % (
                       r["dofs"], r["pairs"], r["k"], r["iterations"],
                       r["reference"], r["contact"],
                       r["contact"] / r["reference"], r["step41"],
                       r["step41"] / r["contact"], r["ordering"],
                       r["factorisation"], r["schur_complement"],
-                      r["active_set_loop"], r["expansion"], r["setup"],
-                      r["assembly"], r["output"],
-                      r["memory"] * 1024 / r["dofs"]))
+                      r["loop_setup"], r["active_set_loop"], r["expansion"],
+                      r["setup"], r["assembly"], r["output"],
+                      r["memory"] * 1024 / r["dofs"],
+                      r["factor_memory_MB"] * 1024 / r["dofs"],
+                      r["dense_memory_MB"] * 1024 / r["dofs"]))
         sizes = [r["dofs"] for r in rows]
         print("fitted exponent (time ~ dofs^b, sizes >= 1e4): contact solve "
               "%.2f, one solve %.2f, step-41 %.2f" % (

@@ -295,6 +295,16 @@ namespace knee_contact
         return block;
       }
 
+      /** Memory of the factor's values and row indices [MB]. */
+      double
+      memory_MB() const
+      {
+        if (factor == nullptr)
+          return 0;
+        return (factor->xsize * sizeof(double) + factor->ssize * sizeof(int)) /
+               1048576.;
+      }
+
       /** x = solve(system, b) for CHOLMOD_P, _L, _Lt, _Pt, _A. */
       void
       solve(const int system, std::vector<double> &b)
@@ -460,6 +470,10 @@ namespace knee_contact
 
     clock.restart();
     d.set_up_multiplier_loop();
+    // The multiplier loop needs only S~'s factor, W and G; the elimination
+    // path makes S again from L_cc if it is ever needed.
+    if (d.multiplier_loop)
+      std::vector<double>().swap(d.s);
     d.timings.loop_setup = clock.wall_time();
   }
 
@@ -597,6 +611,18 @@ namespace knee_contact
 
 
 
+  std::pair<double, double>
+  CondensedContactSystem::memory_MB() const
+  {
+    const Implementation &d = *implementation;
+    const double dense      = (d.l_cc.size() + d.s.size() + d.s_tilde.size() +
+                          d.w.size() + d.g.size()) *
+                         sizeof(double) / 1048576.;
+    return {d.cholesky.memory_MB(), dense};
+  }
+
+
+
   const CondensedContactSystem::Timings &
   CondensedContactSystem::timings() const
   {
@@ -645,6 +671,8 @@ namespace knee_contact
   {
     Implementation   &d = *this;
     const std::size_t k = d.dofs.size();
+    if (s.empty())
+      s = product_with_transpose(l_cc, k, shift);
     // The active rows, each solved for its eliminated dof, as constraints
     // on the local indices; close() resolves chains (a row whose
     // eliminated dof another row refers to), as in the full path.
@@ -742,14 +770,17 @@ namespace knee_contact
 
     // Multipliers from the condensed residual r_c = f - S x_c, which is
     // A'^T lambda on the contact unknowns.
+    // S x_c = L_cc (L_cc^T x_c) - shift x_c: S itself is not kept.
+    std::vector<double> s_x = d.x_c;
+    if (k > 0)
+      {
+        const types::blas_int n = k, one = 1;
+        trmv("L", "T", "N", &n, d.l_cc.data(), &n, s_x.data(), &one);
+        trmv("L", "N", "N", &n, d.l_cc.data(), &n, s_x.data(), &one);
+      }
     Vector<double> residual(d.matrix.m());
     for (unsigned int i = 0; i < k; ++i)
-      {
-        double r = d.f[i];
-        for (unsigned int j = 0; j < k; ++j)
-          r -= d.s[j * k + i] * d.x_c[j];
-        residual(d.dofs[i]) = r;
-      }
+      residual(d.dofs[i]) = d.f[i] - (s_x[i] - d.shift * d.x_c[i]);
     lambda = ActiveSetSolver::multipliers(residual,
                                           AffineConstraints<double>(),
                                           d.pairs,

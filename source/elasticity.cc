@@ -103,12 +103,16 @@ namespace knee_contact
       copy.dof_indices.resize(n);
       cell->get_dof_indices(copy.dof_indices);
 
-      scratch.fe_values.reinit(cell);
+      // A further load case with zero body force needs only the faces.
+      const bool volume = with_matrix || !material.body_force_is_zero;
+      if (volume)
+        scratch.fe_values.reinit(cell);
       const FEValues<2> &fev = scratch.fe_values;
       Vector<double>     force(2);
-      for (const unsigned int q : fev.quadrature_point_indices())
+      for (unsigned int q = 0; volume && q < fev.n_quadrature_points; ++q)
         {
-          material.body_force->vector_value(fev.quadrature_point(q), force);
+          if (!material.body_force_is_zero)
+            material.body_force->vector_value(fev.quadrature_point(q), force);
           for (unsigned int i = 0; i < n; ++i)
             {
               const unsigned int ci = fe.system_to_component_index(i).first;

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <iomanip>
 #include <limits>
 #include <sstream>
@@ -151,6 +152,15 @@ namespace knee_contact
                                   "Materials/" + section + "/Body force",
                                   "",
                                   true);
+        // Written as zeros ("0; 0", the default): assembly skips it.
+        material.body_force_is_zero = true;
+        for (const auto &part : input::split(prm.get("Body force"), ';'))
+          {
+            char        *end   = nullptr;
+            const double value = std::strtod(part.c_str(), &end);
+            material.body_force_is_zero &=
+              end != part.c_str() && *end == '\0' && value == 0;
+          }
         prm.leave_subsection();
       }
     prm.leave_subsection();

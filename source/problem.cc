@@ -377,6 +377,9 @@ namespace knee_contact
             solver_figures["factorisation"]    = t.factorisation;
             solver_figures["schur_complement"] = t.schur;
             solver_figures["loop_setup"]       = t.loop_setup;
+            const auto [factor_MB, dense_MB]   = condensed_system->memory_MB();
+            solver_figures["factor_memory_MB"] = factor_MB;
+            solver_figures["dense_memory_MB"]  = dense_MB;
             solver_figures["condensation"]     = t.condensation;
             solver_figures["active_set_loop"]  = t.dense;
             solver_figures["expansion"]        = t.expansion;

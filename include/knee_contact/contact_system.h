@@ -9,6 +9,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace knee_contact
@@ -173,13 +174,20 @@ namespace knee_contact
       double factorisation = 0;
       double schur         = 0;
       /** S~ = S + rho B^T B, its factor, W and G (multiplier loop). */
-      double loop_setup    = 0;
-      double condensation  = 0;
-      double dense         = 0;
-      double expansion     = 0;
+      double loop_setup   = 0;
+      double condensation = 0;
+      double dense        = 0;
+      double expansion    = 0;
     };
     const Timings &
     timings() const;
+
+    /**
+     * Memory [MB] of the sparse factor (values and row indices) and of the
+     * dense matrices (L_cc, S~'s factor, W, G), for the benchmark.
+     */
+    std::pair<double, double>
+    memory_MB() const;
 
   private:
     class Implementation;

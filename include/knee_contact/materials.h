@@ -34,6 +34,8 @@ namespace knee_contact
      */
     bool                               reduced_volumetric = false;
     std::unique_ptr<FunctionParser<2>> body_force;
+    /** The body force is written as zeros: nothing to integrate. */
+    bool body_force_is_zero = false;
 
     /**
      * In-plane stress from in-plane strain.
