@@ -262,25 +262,17 @@ namespace knee_contact
           // zone start active (the loop corrects the guess).
           std::vector<bool> guess;
           if (cycle > 0)
-            guess.assign(contact_pairs.size(), false);
-          if (cycle > 0)
-            for (unsigned int p = 0; p < contact_pairs.size(); ++p)
-              for (const auto &[position, length] : previous_contact)
-                if (contact_pairs[p].position.distance(position) <= length)
-                  guess[p] = true;
+            {
+              guess.assign(contact_pairs.size(), false);
+              for (unsigned int p = 0; p < contact_pairs.size(); ++p)
+                for (const auto &[position, length] : previous_contact)
+                  if (contact_pairs[p].position.distance(position) <= length)
+                    guess[p] = true;
+            }
           solve_contact(guess, true);
         });
         timed("postprocess", [&]() {
-          results       = compute_results(dof_handler,
-                                    body_of_cell,
-                                    system_matrix,
-                                    system_rhs,
-                                    displacement,
-                                    materials,
-                                    boundary_conditions,
-                                    contact_interfaces,
-                                    contact_pairs,
-                                    contact_solution);
+          results       = current_results();
           record.errors = verification.compute_errors(
             dof_handler, displacement, materials, contact_pairs, results);
         });
@@ -434,6 +426,23 @@ namespace knee_contact
 
 
 
+  Results
+  ContactProblem::current_results() const
+  {
+    return compute_results(dof_handler,
+                           body_of_cell,
+                           system_matrix,
+                           system_rhs,
+                           displacement,
+                           materials,
+                           boundary_conditions,
+                           contact_interfaces,
+                           contact_pairs,
+                           contact_solution);
+  }
+
+
+
   void
   ContactProblem::set_load_parameter(const double t)
   {
@@ -521,7 +530,11 @@ namespace knee_contact
       r.converged    = contact_solution.converged;
       r.solve_time   = solve_time;
       r.results      = results;
-      records.push_back(r);
+      // The table needs the figures, not the per-cell and per-pair fields
+      // (tens of MB per case on a fine mesh).
+      std::vector<std::array<double, 4>>().swap(r.results.vertex_stress_yy);
+      std::vector<double>().swap(r.results.pressure);
+      records.push_back(std::move(r));
     };
     record(t[0], solver_figures["contact_solve"], first_results);
     if (output_writer.enabled())
@@ -551,16 +564,7 @@ namespace knee_contact
         Results      results;
         {
           TimerOutput::Scope scope(timer, "postprocess");
-          results = compute_results(dof_handler,
-                                    body_of_cell,
-                                    system_matrix,
-                                    system_rhs,
-                                    displacement,
-                                    materials,
-                                    boundary_conditions,
-                                    contact_interfaces,
-                                    contact_pairs,
-                                    contact_solution);
+          results = current_results();
         }
         print_results(results);
         const Errors errors = verification.compute_errors(

@@ -168,6 +168,10 @@ namespace knee_contact
     void
     solve_contact(const std::vector<bool> &guess, const bool new_matrix);
 
+    /** The derived quantities (compute_results()) of the current solution. */
+    Results
+    current_results() const;
+
     /** Evaluate loads and exact solutions at load parameter @p t. */
     void
     set_load_parameter(const double t);
