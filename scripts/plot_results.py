@@ -76,7 +76,10 @@ def stress_yy(folder, material, vertex):
     y = vertex[:, :, 1].ravel()
     value = vertex[:, :, 4].ravel() / 1e6
     base = 4 * np.arange(n)[:, None]
-    triangles = np.vstack([base + [0, 1, 2], base + [0, 2, 3]])
+    # A triangle (P1) repeats its third vertex: it has no second half.
+    quadrilateral = ~np.all(vertex[:, 2, 0:2] == vertex[:, 3, 0:2], axis=1)
+    triangles = np.vstack([base + [0, 1, 2],
+                           (base + [0, 2, 3])[quadrilateral]])
     low, high = np.percentile(value, [0.5, 99.5])
     figure, axes = plt.subplots(figsize=(8, 8))
     image = axes.tripcolor(mtri.Triangulation(x, y, triangles), value,

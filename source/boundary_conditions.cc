@@ -1,4 +1,5 @@
 #include <knee_contact/boundary_conditions.h>
+#include <knee_contact/elements.h>
 #include <knee_contact/input.h>
 
 #include <deal.II/dofs/dof_tools.h>
@@ -134,8 +135,13 @@ namespace knee_contact
     for (const auto &condition : list)
       if (condition.type == BoundaryType::displacement)
         for (const auto id : condition.ids)
-          VectorTools::interpolate_boundary_values(
-            dof_handler, id, *condition.function, constraints, condition.mask);
+          VectorTools::interpolate_boundary_values(elements::mapping(
+                                                     dof_handler),
+                                                   dof_handler,
+                                                   id,
+                                                   *condition.function,
+                                                   constraints,
+                                                   condition.mask);
 
     std::set<types::boundary_id> sliding;
     for (const auto &condition : list)
@@ -145,7 +151,11 @@ namespace knee_contact
       {
         AffineConstraints<double> sliding_constraints;
         VectorTools::compute_no_normal_flux_constraints(
-          dof_handler, 0, sliding, sliding_constraints, MappingQ1<2>());
+          dof_handler,
+          0,
+          sliding,
+          sliding_constraints,
+          elements::mapping(dof_handler));
         sliding_constraints.close();
         constraints.merge(
           sliding_constraints,

@@ -1,4 +1,5 @@
 #include <knee_contact/elasticity.h>
+#include <knee_contact/elements.h>
 
 #include <deal.II/base/quadrature_lib.h>
 #include <deal.II/base/work_stream.h>
@@ -11,28 +12,34 @@ namespace knee_contact
   {
     struct ScratchData
     {
-      ScratchData(const FiniteElement<2> &fe)
-        : fe_values(fe,
-                    QGauss<2>(fe.degree + 1),
+      ScratchData(const DoFHandler<2> &dof_handler)
+        : fe_values(elements::mapping(dof_handler),
+                    dof_handler.get_fe(),
+                    elements::cell_quadrature(dof_handler, 2),
                     update_values | update_gradients |
                       update_quadrature_points | update_JxW_values)
-        , fe_values_reduced(fe,
-                            QGauss<2>(fe.degree),
+        , fe_values_reduced(elements::mapping(dof_handler),
+                            dof_handler.get_fe(),
+                            elements::cell_quadrature(dof_handler, 1),
                             update_gradients | update_JxW_values)
-        , fe_face_values(fe,
-                         QGauss<1>(fe.degree + 1),
+        , fe_face_values(elements::mapping(dof_handler),
+                         dof_handler.get_fe(),
+                         QGauss<1>(2),
                          update_values | update_quadrature_points |
                            update_normal_vectors | update_JxW_values)
       {}
 
       ScratchData(const ScratchData &other)
-        : fe_values(other.fe_values.get_fe(),
+        : fe_values(other.fe_values.get_mapping(),
+                    other.fe_values.get_fe(),
                     other.fe_values.get_quadrature(),
                     other.fe_values.get_update_flags())
-        , fe_values_reduced(other.fe_values_reduced.get_fe(),
+        , fe_values_reduced(other.fe_values_reduced.get_mapping(),
+                            other.fe_values_reduced.get_fe(),
                             other.fe_values_reduced.get_quadrature(),
                             other.fe_values_reduced.get_update_flags())
-        , fe_face_values(other.fe_face_values.get_fe(),
+        , fe_face_values(other.fe_face_values.get_mapping(),
+                         other.fe_face_values.get_fe(),
                          other.fe_face_values.get_quadrature(),
                          other.fe_face_values.get_update_flags())
       {}
@@ -187,7 +194,7 @@ namespace knee_contact
                     dof_handler.end(),
                     worker,
                     copier,
-                    ScratchData(dof_handler.get_fe()),
+                    ScratchData(dof_handler),
                     CopyData());
   }
 } // namespace knee_contact

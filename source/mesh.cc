@@ -2,17 +2,20 @@
 #include <knee_contact/input.h>
 #include <knee_contact/interruption.h>
 #include <knee_contact/mesh.h>
+#include <knee_contact/mesh_readers.h>
 
 #include <deal.II/grid/grid_in.h>
 #include <deal.II/grid/grid_tools.h>
 #include <deal.II/grid/manifold_lib.h>
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <numeric>
+#include <tuple>
 
 namespace knee_contact
 {
@@ -23,16 +26,48 @@ namespace knee_contact
     prm.declare_entry("Source",
                       "rectangles",
                       Patterns::Selection("rectangles|file"),
-                      "Where the mesh comes from: 'file' (Gmsh .msh, or .geo "
-                      "meshed by the gmsh program) or 'rectangles' (built in, "
-                      "for simple scenes and tests).");
+                      "Where the mesh comes from: 'file' (Gmsh .msh or .geo, "
+                      "Abaqus .inp, legacy VTK .vtk) or 'rectangles' (built "
+                      "in, for simple scenes and tests).");
     prm.declare_entry("File",
                       "",
                       Patterns::Anything(),
-                      "Gmsh file (.msh or .geo), relative to the scene file. "
-                      "Physical surfaces become material ids, physical curves "
-                      "boundary ids. Cells must be quadrilaterals (in a .geo: "
-                      "Recombine, or Mesh.SubdivisionAlgorithm = 1).");
+                      "Mesh file, relative to the scene file, read by its "
+                      "extension: .msh (Gmsh 2.2 or 4.1 ASCII) or .geo "
+                      "(meshed by the gmsh program): physical surfaces become "
+                      "material ids, physical curves boundary ids; .inp "
+                      "(Abaqus input deck): see Abaqus element sets and "
+                      "Abaqus boundary sets; .vtk (legacy ASCII VTK, "
+                      "unstructured grid): the cell field MaterialID gives "
+                      "material ids, and of line cells boundary ids. Cells "
+                      "are triangles, quadrilaterals or both.");
+    prm.declare_entry("Triangles",
+                      "P1",
+                      Patterns::Selection("P1|quadrilaterals"),
+                      "How a mesh of triangles is solved: 'P1' (the seed's "
+                      "linear triangles) or 'quadrilaterals' (each triangle "
+                      "split at its centroid into three quadrilaterals, "
+                      "solved with Q1). A mesh of triangles and "
+                      "quadrilaterals is always split (every triangle into "
+                      "three, every quadrilateral into four), and so is a "
+                      "triangle mesh refined adaptively: deal.II 9.4 cannot "
+                      "do these with triangles (see the README).");
+    prm.declare_entry("Abaqus element sets",
+                      "",
+                      Patterns::Anything(),
+                      "For an .inp file: 'NAME: material id; ...', the "
+                      "element sets (*Elset, or ELSET= of *Element) that "
+                      "make the materials. Empty: the element sets of the "
+                      "*Solid Section lines get material ids 1, 2, ... in "
+                      "file order.");
+    prm.declare_entry("Abaqus boundary sets",
+                      "",
+                      Patterns::Anything(),
+                      "For an .inp file: 'NAME: boundary id; ...', surfaces "
+                      "(*Surface, element faces S1-S4) or node sets (*Nset: "
+                      "the boundary edges whose two nodes are in the set) "
+                      "that the boundary conditions and contact interfaces "
+                      "name by id.");
     prm.declare_entry("Gmsh arguments",
                       "",
                       Patterns::Anything(),
@@ -54,6 +89,13 @@ namespace knee_contact
       "x1, y1, n_x, n_y, material id, group, left id, right id, bottom id, "
       "top id' (lengths in m). Rectangles of the same group share vertices "
       "where they meet (bonded); different groups never do (contact).");
+    prm.declare_entry("Rectangle cells",
+                      "quadrilaterals",
+                      Patterns::Selection("quadrilaterals|triangles|mixed"),
+                      "For Source = rectangles: the cells of each grid "
+                      "cell: one quadrilateral, two triangles (cut from "
+                      "lower left to upper right), or mixed (a checkerboard "
+                      "of both).");
     prm.declare_entry("Rotation angle",
                       "0",
                       Patterns::Double(),
@@ -83,6 +125,29 @@ namespace knee_contact
     file   = input::resolve_path(prm.get("File"), scene_file);
     gmsh_arguments   = gmsh_input::arguments(prm.get("Gmsh arguments"));
     gmsh_time_limit  = prm.get_double("Gmsh time limit");
+    split_triangles  = prm.get("Triangles") == "quadrilaterals";
+    rectangle_cells =
+      prm.get("Rectangle cells") == "triangles" ? RectangleCells::triangles :
+      prm.get("Rectangle cells") == "mixed"     ? RectangleCells::mixed :
+                                                  RectangleCells::quadrilaterals;
+    for (auto [name, sets] :
+         {std::make_pair("Abaqus element sets", &abaqus_element_sets),
+          std::make_pair("Abaqus boundary sets", &abaqus_boundary_sets)})
+      {
+        const std::string parameter = "Mesh/" + std::string(name);
+        for (const auto &[set, id_text] :
+             input::split_named(prm.get(name), parameter, "NAME: id"))
+          {
+            const double id = input::to_double(id_text, parameter);
+            AssertThrow(id >= 0 && id < 255 && id == std::floor(id),
+                        ExcMessage(parameter + ": '" + id_text +
+                                   "' for set '" + set +
+                                   "' is not an id in 0..254"));
+            AssertThrow(sets->emplace(set, static_cast<unsigned int>(id)).second,
+                        ExcMessage(parameter + ": set '" + set +
+                                   "' is named twice"));
+          }
+      }
     rotation_degrees = prm.get_double("Rotation angle");
     n_refinements    = prm.get_integer("Global refinements");
     AssertThrow(std::isfinite(rotation_degrees),
@@ -149,7 +214,7 @@ namespace knee_contact
   {
     triangulation.clear();
     if (source == Source::file)
-      read_gmsh(triangulation);
+      read_file(triangulation);
     else
       make_rectangles(triangulation);
 
@@ -242,18 +307,22 @@ namespace knee_contact
   {
     // The Jacobian of a bilinear quadrilateral is positive everywhere iff
     // the cross products of the edges at all four corners are (deal.II's
-    // vertex order 0 1 3 2 runs counter-clockwise). Checked on every mesh
+    // vertex order 0 1 3 2 runs counter-clockwise); a triangle's at any. Checked on every mesh
     // the program solves on: refinement on a circle that does not fit the
     // vertices can fold cells.
     for (const auto &cell : triangulation.active_cell_iterators())
       {
-        const unsigned int ring[4] = {0, 1, 3, 2};
-        for (unsigned int k = 0; k < 4; ++k)
+        // A triangle's vertices 0 1 2 run counter-clockwise too.
+        const std::array<unsigned int, 4> ring =
+          cell->n_vertices() == 3 ? std::array<unsigned int, 4>{{0, 1, 2}} :
+                                    std::array<unsigned int, 4>{{0, 1, 3, 2}};
+        const unsigned int n = cell->n_vertices();
+        for (unsigned int k = 0; k < n; ++k)
           {
             const Tensor<1, 2> a =
-              cell->vertex(ring[(k + 1) % 4]) - cell->vertex(ring[k]);
+              cell->vertex(ring[(k + 1) % n]) - cell->vertex(ring[k]);
             const Tensor<1, 2> b =
-              cell->vertex(ring[(k + 3) % 4]) - cell->vertex(ring[k]);
+              cell->vertex(ring[(k + n - 1) % n]) - cell->vertex(ring[k]);
             AssertThrow(a[0] * b[1] - a[1] * b[0] > 1e-12 * a.norm() * b.norm(),
                         ExcMessage("Mesh: cell at (" +
                                    std::to_string(cell->center()[0]) + ", " +
@@ -269,8 +338,8 @@ namespace knee_contact
 
 
 
-  void
-  MeshInput::read_gmsh(Triangulation<2> &triangulation) const
+  mesh_readers::Description
+  MeshInput::read_gmsh() const
   {
     std::string msh = file;
     std::string temporary_folder;
@@ -323,8 +392,9 @@ namespace knee_contact
         AssertThrow(false, ExcMessage(message));
       }
 
-    GridIn<2> grid_in;
-    grid_in.attach_triangulation(triangulation);
+    Triangulation<2> read;
+    GridIn<2>        grid_in;
+    grid_in.attach_triangulation(read);
     std::ifstream in(msh);
     try
       {
@@ -339,19 +409,110 @@ namespace knee_contact
                                input::one_line(exc.what()) + ")"));
       }
     remove_temporary();
-    AssertThrow(triangulation.all_reference_cells_are_hyper_cube(),
-                ExcMessage("Mesh/File: '" + file +
-                           "' has triangles; knee_contact needs "
-                           "quadrilaterals (Recombine the surfaces)"));
+    mesh_readers::Description mesh;
+    std::tie(mesh.vertices, mesh.cells, mesh.subcells) =
+      GridTools::get_coarse_mesh_description(read);
+    return mesh;
+  }
 
-    // Gmsh orients the cells of a surface whose curve loop runs clockwise
-    // clockwise too, and GridIn keeps that; deal.II needs counter-clockwise
-    // cells, so rebuild the mesh with such cells turned over.
-    auto [vertices, cells, subcell_data] =
-      GridTools::get_coarse_mesh_description(triangulation);
-    GridTools::invert_all_negative_measure_cells(vertices, cells);
-    triangulation.clear();
-    triangulation.create_triangulation(vertices, cells, subcell_data);
+
+
+  mesh_readers::Description
+  MeshInput::read_vtk() const
+  {
+    mesh_readers::check_vtk(file);
+    Triangulation<2> read;
+    GridIn<2>        grid_in;
+    grid_in.attach_triangulation(read);
+    std::ifstream in(file);
+    try
+      {
+        grid_in.read_vtk(in);
+      }
+    catch (const std::exception &exc)
+      {
+        AssertThrow(false,
+                    ExcMessage("Mesh/File: cannot read '" + file +
+                               "' as a VTK mesh (" +
+                               input::one_line(exc.what()) + ")"));
+      }
+    mesh_readers::Description mesh;
+    std::tie(mesh.vertices, mesh.cells, mesh.subcells) =
+      GridTools::get_coarse_mesh_description(read);
+    return mesh;
+  }
+
+
+
+  void
+  MeshInput::read_file(Triangulation<2> &triangulation) const
+  {
+    const std::string extension = std::filesystem::path(file).extension();
+    mesh_readers::Description mesh;
+    if (extension == ".msh" || extension == ".geo")
+      mesh = read_gmsh();
+    else if (extension == ".inp")
+      mesh = mesh_readers::read_abaqus(file,
+                                       abaqus_element_sets,
+                                       abaqus_boundary_sets);
+    else if (extension == ".vtk")
+      mesh = read_vtk();
+    else
+      AssertThrow(false,
+                  ExcMessage("Mesh/File: '" + file +
+                             "' has an extension knee_contact does not read "
+                             "(.msh, .geo, .inp, .vtk)"));
+    AssertThrow(extension == ".inp" || (abaqus_element_sets.empty() &&
+                                        abaqus_boundary_sets.empty()),
+                ExcMessage("Mesh/Abaqus element sets and Abaqus boundary sets "
+                           "are for .inp files, not '" +
+                           file + "'"));
+
+    // Cells turned the wrong way round (Gmsh keeps the orientation of a
+    // clockwise curve loop, other tools list clockwise cells) are turned
+    // over; check_cells() refuses what is still inverted or degenerate.
+    try
+      {
+        GridTools::invert_cells_with_negative_measure(mesh.vertices,
+                                                      mesh.cells);
+      }
+    catch (const std::exception &)
+      {
+        AssertThrow(false,
+                    ExcMessage("Mesh/File: '" + file +
+                               "' has a cell that is degenerate or not "
+                               "convex"));
+      }
+
+    finish(mesh, triangulation);
+  }
+
+
+
+  void
+  MeshInput::finish(mesh_readers::Description &mesh,
+                    Triangulation<2>          &triangulation) const
+  {
+    bool triangles = false, quadrilaterals = false;
+    for (const auto &cell : mesh.cells)
+      (cell.vertices.size() == 3 ? triangles : quadrilaterals) = true;
+    if (triangles && (quadrilaterals || split_triangles || adaptive))
+      mesh_readers::split_into_quadrilaterals(mesh, circular_boundaries);
+    try
+      {
+        triangulation.create_triangulation(mesh.vertices,
+                                           mesh.cells,
+                                           mesh.subcells);
+      }
+    catch (const std::exception &exc)
+      {
+        AssertThrow(false,
+                    ExcMessage((source == Source::file ?
+                                  "Mesh/File: '" + file + "'" :
+                                  std::string("Mesh/Rectangles: the mesh")) +
+                               " is not a valid mesh (" +
+                               input::one_line(exc.what()) + ")"));
+      }
   }
 
 
@@ -362,8 +523,8 @@ namespace knee_contact
     // Vertices are shared within a group of rectangles (bonded) and never
     // between groups (contact), which GridGenerator::merge_triangulations
     // cannot express; so the cells are listed here directly.
-    std::vector<Point<2>>    vertices;
-    std::vector<CellData<2>> cells;
+    mesh_readers::Description mesh;
+    std::vector<Point<2>>    &vertices = mesh.vertices;
     std::map<std::pair<unsigned int, std::pair<long, long>>, unsigned int>
            vertex_index;
     double h = std::numeric_limits<double>::max();
@@ -402,16 +563,29 @@ namespace knee_contact
         for (unsigned int j = 0; j < rect.n_y; ++j)
           for (unsigned int i = 0; i < rect.n_x; ++i)
             {
-              CellData<2> cell;
-              cell.vertices    = {index[j * (rect.n_x + 1) + i],
-                                  index[j * (rect.n_x + 1) + i + 1],
-                                  index[(j + 1) * (rect.n_x + 1) + i],
-                                  index[(j + 1) * (rect.n_x + 1) + i + 1]};
-              cell.material_id = rect.material_id;
-              cells.push_back(cell);
+              const unsigned int a = index[j * (rect.n_x + 1) + i],
+                                 b = index[j * (rect.n_x + 1) + i + 1],
+                                 c = index[(j + 1) * (rect.n_x + 1) + i],
+                                 d = index[(j + 1) * (rect.n_x + 1) + i + 1];
+              const bool split =
+                rectangle_cells == RectangleCells::triangles ||
+                (rectangle_cells == RectangleCells::mixed && (i + j) % 2 == 1);
+              // Two counter-clockwise triangles cut along the diagonal a-d,
+              // or one quadrilateral.
+              for (const auto &corners :
+                   split ? std::vector<std::vector<unsigned int>>{{a, b, d},
+                                                                  {a, d, c}} :
+                           std::vector<std::vector<unsigned int>>{
+                             {a, b, c, d}})
+                {
+                  CellData<2> cell(corners.size());
+                  cell.vertices    = corners;
+                  cell.material_id = rect.material_id;
+                  mesh.cells.push_back(cell);
+                }
             }
       }
-    triangulation.create_triangulation(vertices, cells, SubCellData());
+    finish(mesh, triangulation);
 
     // Boundary ids by the side of the cell's rectangle each boundary face
     // lies on.

@@ -1,3 +1,4 @@
+#include <knee_contact/elements.h>
 #include <knee_contact/elasticity.h>
 #include <knee_contact/input.h>
 #include <knee_contact/problem.h>
@@ -13,7 +14,6 @@
 #include <deal.II/lac/sparse_direct.h>
 
 #include <deal.II/dofs/dof_tools.h>
-#include <deal.II/fe/fe_q.h>
 
 #include <cmath>
 #include <filesystem>
@@ -105,7 +105,6 @@ namespace knee_contact
 
   ContactProblem::ContactProblem(const std::string &scene_file)
     : scene_file(scene_file)
-    , fe(FE_Q<2>(1), 2)
   {
     const Counts       counts = read_counts(scene_file);
     const SceneOutline outline(scene_file);
@@ -134,6 +133,7 @@ namespace knee_contact
     output_writer.parse_parameters(prm, scene_file);
     verification.parse_parameters(prm);
     refinement.parse_parameters(prm);
+    mesh_input.adaptive = refinement.strategy != Refinement::Strategy::global;
     scene_checks::check_roles(boundary_conditions, contact_interfaces);
   }
 
@@ -156,6 +156,7 @@ namespace knee_contact
   ContactProblem::make_mesh()
   {
     mesh_input.create(triangulation);
+    fe = elements::displacement_element<2>(elements::cell_kind(triangulation));
     materials.check_mesh(triangulation);
     boundary_conditions.check_mesh(triangulation);
     body_of_cell = compute_body_ids(triangulation, n_bodies);
@@ -181,7 +182,7 @@ namespace knee_contact
   ContactProblem::setup_system()
   {
     dof_handler.reinit(triangulation);
-    dof_handler.distribute_dofs(fe);
+    dof_handler.distribute_dofs(*fe);
     body_of_cell = compute_body_ids(triangulation, n_bodies);
     body_names.assign(n_bodies, "");
     std::vector<std::set<types::material_id>> body_materials(n_bodies);

@@ -1,3 +1,4 @@
+#include <knee_contact/elements.h>
 #include <knee_contact/refinement.h>
 
 #include <deal.II/base/quadrature_lib.h>
@@ -90,8 +91,12 @@ namespace knee_contact
         return;
       }
     Vector<float> kelly(triangulation.n_active_cells());
-    KellyErrorEstimator<2>::estimate(
-      dof_handler, QGauss<1>(2), {}, solution, kelly);
+    KellyErrorEstimator<2>::estimate(elements::mapping(dof_handler),
+                                     dof_handler,
+                                     QGauss<1>(2),
+                                     {},
+                                     solution,
+                                     kelly);
     for (const auto &cell : triangulation.active_cell_iterators())
       kelly(cell->active_cell_index()) *=
         std::sqrt(materials[cell->material_id()].youngs_modulus);

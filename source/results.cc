@@ -1,3 +1,4 @@
+#include <knee_contact/elements.h>
 #include <knee_contact/results.h>
 
 #include <deal.II/base/quadrature_lib.h>
@@ -115,10 +116,16 @@ namespace knee_contact
     results.equilibrium_residual = scale > 0 ? balance.norm() / scale : 0;
 
     // tau_yy at the vertices of every cell, as the pictures show it.
-    FEValues<2>                        fe_values(dof_handler.get_fe(),
-                          QTrapezoid<2>(),
+    // (Q1: the trapezoidal rule's points are the vertices in deal.II's
+    // order; P1: the triangle's vertices. A triangle repeats its third
+    // vertex in the fourth entry, as cells.npy does.)
+    const ReferenceCell kind = dof_handler.get_fe().reference_cell();
+    FEValues<2>         fe_values(elements::mapping(dof_handler),
+                          dof_handler.get_fe(),
+                          kind.get_nodal_type_quadrature<2>(),
                           update_gradients);
-    std::vector<SymmetricTensor<2, 2>> strains(4);
+    const unsigned int  n_vertices = kind.n_vertices();
+    std::vector<SymmetricTensor<2, 2>> strains(n_vertices);
     const FEValuesExtractors::Vector   displacement(0);
     results.vertex_stress_yy.resize(results.n_cells);
     for (const auto &cell : dof_handler.active_cell_iterators())
@@ -133,7 +140,8 @@ namespace knee_contact
                          -std::numeric_limits<double>::max()));
         for (unsigned int v = 0; v < 4; ++v)
           {
-            const double syy = material.stress(strains[v])[1][1];
+            const double syy =
+              material.stress(strains[std::min(v, n_vertices - 1)])[1][1];
             results.vertex_stress_yy[cell->active_cell_index()][v] = syy;
             range.first->second.first =
               std::min(range.first->second.first, syy);

@@ -1,3 +1,4 @@
+#include <knee_contact/elements.h>
 #include <knee_contact/rigid_modes.h>
 
 #include <deal.II/lac/full_matrix.h>
@@ -21,7 +22,7 @@ namespace knee_contact
     , size(body_names.size())
     , names(body_names)
   {
-    DoFTools::map_dofs_to_support_points(MappingQ1<2>(),
+    DoFTools::map_dofs_to_support_points(elements::mapping(dof_handler),
                                          dof_handler,
                                          dof_position);
     std::vector<types::global_dof_index> dofs(

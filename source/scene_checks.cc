@@ -3,6 +3,8 @@
 #include <deal.II/base/bounding_box.h>
 #include <deal.II/base/quadrature_lib.h>
 
+#include <deal.II/fe/mapping.h>
+
 #include <deal.II/lac/vector.h>
 
 #include <deal.II/grid/grid_tools.h>
@@ -71,7 +73,6 @@ namespace knee_contact
                       const Materials          &materials,
                       const BoundaryConditions &conditions)
     {
-      const QGauss<2> cell_points(2);
       const QGauss<1> face_points(2);
       Vector<double>  values(2);
       const auto      check = [&](const Function<2> &function,
@@ -93,15 +94,15 @@ namespace knee_contact
             "Materials (material '" + material.name + "')/Body force";
           for (const auto v : cell->vertex_indices())
             check(force, cell->vertex(v), parameter, "");
-          // Bilinear map of the Gauss points (MappingQ1).
-          for (const auto &xi : cell_points.get_points())
-            {
-              Point<2> p;
-              for (const auto v : cell->vertex_indices())
-                p += cell->vertex(v) * ((v % 2 ? xi[0] : 1 - xi[0]) *
-                                        (v / 2 ? xi[1] : 1 - xi[1]));
-              check(force, p, parameter, "");
-            }
+          // The Gauss points, mapped as the assembly maps them.
+          const auto &mapping =
+            cell->reference_cell().get_default_linear_mapping<2, 2>();
+          for (const auto &xi :
+               cell->reference_cell().get_gauss_type_quadrature<2>(2).get_points())
+            check(force,
+                  mapping.transform_unit_to_real_cell(cell, xi),
+                  parameter,
+                  "");
           for (const auto f : cell->face_indices())
             if (cell->face(f)->at_boundary())
               for (const auto &condition : conditions.conditions())

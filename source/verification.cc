@@ -1,4 +1,5 @@
 #include <knee_contact/input.h>
+#include <knee_contact/elements.h>
 #include <knee_contact/verification.h>
 
 #include <deal.II/base/quadrature_lib.h>
@@ -200,8 +201,9 @@ namespace knee_contact
         // Errors in L2, in the energy norm a(e, e)^1/2 and of the stress at
         // Gauss points; the exact gradient comes from fourth order
         // differences of the expression.
-        FEValues<2>                        fe_values(dof_handler.get_fe(),
-                              QGauss<2>(3),
+        FEValues<2> fe_values(elements::mapping(dof_handler),
+                              dof_handler.get_fe(),
+                              elements::cell_quadrature(dof_handler, 3),
                               update_values | update_gradients |
                                 update_quadrature_points | update_JxW_values);
         const FEValuesExtractors::Vector   u(0);

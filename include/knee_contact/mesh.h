@@ -1,6 +1,8 @@
 #ifndef knee_contact_mesh_h
 #define knee_contact_mesh_h
 
+#include <knee_contact/mesh_readers.h>
+
 #include <deal.II/base/parameter_handler.h>
 #include <deal.II/base/point.h>
 
@@ -16,8 +18,9 @@ namespace knee_contact
   using namespace dealii;
 
   /**
-   * One Triangulation<2> holding all bodies: read from a Gmsh file (.geo is
-   * meshed by the gmsh program first) or generated from rectangles. Physical
+   * One Triangulation<2> holding all bodies: read from a mesh file (Gmsh
+   * .msh or .geo, which the gmsh program meshes first; Abaqus .inp; legacy
+   * VTK .vtk) or generated from rectangles. Physical
    * surfaces are material ids and physical curves boundary ids. Bodies that
    * share vertices are bonded; bodies in contact must have distinct
    * (possibly coincident) vertices on their interface.
@@ -48,8 +51,27 @@ namespace knee_contact
       std::array<types::boundary_id, 4> boundary_ids{}; // left right bottom top
     };
 
+    /**
+     * Read Mesh/File by its extension; split triangles into quadrilaterals
+     * where the solver needs them (mixed meshes, Triangles =
+     * quadrilaterals, adaptive refinement).
+     */
     void
-    read_gmsh(Triangulation<2> &triangulation) const;
+    read_file(Triangulation<2> &triangulation) const;
+
+    mesh_readers::Description
+    read_gmsh() const;
+
+    /**
+     * Split @p mesh's triangles where needed (see read_file) and make
+     * @p triangulation of it.
+     */
+    void
+    finish(mesh_readers::Description &mesh,
+           Triangulation<2>          &triangulation) const;
+
+    mesh_readers::Description
+    read_vtk() const;
 
     void
     make_rectangles(Triangulation<2> &triangulation) const;
@@ -68,6 +90,23 @@ namespace knee_contact
     double                                 rotation_degrees = 0;
     unsigned int                           n_refinements    = 0;
     std::map<types::boundary_id, Point<2>> circular_boundaries;
+    bool                                   split_triangles = false;
+    enum class RectangleCells
+    {
+      quadrilaterals,
+      triangles,
+      mixed
+    } rectangle_cells = RectangleCells::quadrilaterals;
+    std::map<std::string, unsigned int>    abaqus_element_sets;
+    std::map<std::string, unsigned int>    abaqus_boundary_sets;
+
+  public:
+    /**
+     * Set when the scene refines adaptively: deal.II 9.4's Kelly estimator
+     * cannot integrate over the hanging faces of triangles, so a triangle
+     * mesh is then split into quadrilaterals.
+     */
+    bool adaptive = false;
   };
 
 

@@ -220,7 +220,8 @@ namespace knee_contact
     Refinement         refinement;
 
     Triangulation<2>          triangulation;
-    FESystem<2>               fe;
+    // FE_Q(1)^2 or FE_SimplexP(1)^2, by the mesh's cells (make_mesh).
+    std::unique_ptr<FiniteElement<2>> fe;
     DoFHandler<2>             dof_handler;
     std::vector<unsigned int> body_of_cell;
     unsigned int              n_bodies = 0;

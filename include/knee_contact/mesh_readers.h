@@ -1,0 +1,73 @@
+#ifndef knee_contact_mesh_readers_h
+#define knee_contact_mesh_readers_h
+
+#include <deal.II/base/point.h>
+
+#include <deal.II/grid/tria.h>
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace knee_contact
+{
+  using namespace dealii;
+
+  /**
+   * Mesh files other than Gmsh's, made safe before anything builds a mesh of
+   * them, and the one step that turns triangles into quadrilaterals where
+   * the solver needs them. Every error names the file and line.
+   */
+  namespace mesh_readers
+  {
+    /**
+     * A coarse mesh as deal.II's create_triangulation takes it.
+     */
+    struct Description
+    {
+      std::vector<Point<2>>    vertices;
+      std::vector<CellData<2>> cells;
+      SubCellData              subcells;
+    };
+
+    /**
+     * Read an Abaqus input deck (.inp): *Node, *Element (CPS3, CPE3,
+     * CPS4, CPE4 and their R/H/I variants), *Elset, *Nset (with or without
+     * GENERATE), *Surface (TYPE=ELEMENT with S1-S4 faces, or TYPE=NODE).
+     * @p element_sets gives each element set its material id (empty: the
+     * element sets of the *Solid Section lines in file order get 1, 2, ...);
+     * @p boundary_sets gives a surface or node set its boundary id (a
+     * boundary edge whose two nodes are in a node set belongs to it).
+     * Written by hand: deal.II 9.4's read_abaqus reads quadrilaterals only,
+     * takes ids only from names of the form EB<n>, Material-<n>, SS<n>,
+     * and trusts numbering and counts.
+     */
+    Description
+    read_abaqus(const std::string                         &file,
+                const std::map<std::string, unsigned int> &element_sets,
+                const std::map<std::string, unsigned int> &boundary_sets);
+
+    /**
+     * Check a legacy ASCII VTK file (DATASET UNSTRUCTURED_GRID) against its
+     * own counts before deal.II's GridIn::read_vtk, which trusts them:
+     * POINTS, CELLS (vertices, lines, triangles, quadrilaterals), CELL_TYPES
+     * and the CELL_DATA fields MaterialID and ManifoldID (ids < 255).
+     */
+    void
+    check_vtk(const std::string &file);
+
+    /**
+     * Split every triangle into three quadrilaterals at its centroid and,
+     * if there are triangles, every quadrilateral into four at its centre,
+     * so that the mesh stays conforming: the fallback for mixed meshes and
+     * for Mesh/Triangles = quadrilaterals. Edge midpoints of boundary ids in
+     * @p circles (id: centre) are put on the circle.
+     */
+    void
+    split_into_quadrilaterals(
+      Description                                  &mesh,
+      const std::map<types::boundary_id, Point<2>> &circles);
+  } // namespace mesh_readers
+} // namespace knee_contact
+
+#endif
