@@ -51,8 +51,15 @@ Mesh.MeshSizeExtendFromBoundary = 0;
 Mesh.MeshSizeFromPoints = 0;
 Mesh.MeshSizeFromCurvature = 0;
 
-Recombine Surface{1, 2};
-Mesh.SubdivisionAlgorithm = 1;
+// -setnumber triangles 1: leave the triangles (P1) instead of making
+// quadrilaterals.
+If (!Exists(triangles))
+  triangles = 0;
+EndIf
+If (triangles == 0)
+  Recombine Surface{1, 2};
+  Mesh.SubdivisionAlgorithm = 1;
+EndIf
 
 Physical Surface(1) = {1};      // cylinder
 Physical Surface(2) = {2};      // block

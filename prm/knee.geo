@@ -98,8 +98,15 @@ Background Field = 1;
 Mesh.MeshSizeExtendFromBoundary = 0;
 Mesh.MeshSizeFromPoints = 0;
 Mesh.MeshSizeFromCurvature = 0;
-Recombine Surface{:};
-Mesh.SubdivisionAlgorithm = 1;
+// -setnumber triangles 1: leave the triangles (P1) instead of making
+// quadrilaterals.
+If (!Exists(triangles))
+  triangles = 0;
+EndIf
+If (triangles == 0)
+  Recombine Surface{:};
+  Mesh.SubdivisionAlgorithm = 1;
+EndIf
 
 Physical Surface(1) = {3, 4, 32};   // bone: tibia, fibula, femur
 Physical Surface(2) = {1, 2};       // Ti6Al4V: tray and stem

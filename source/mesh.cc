@@ -448,6 +448,11 @@ namespace knee_contact
   MeshInput::read_file(Triangulation<2> &triangulation) const
   {
     const std::string extension = std::filesystem::path(file).extension();
+    AssertThrow(extension == ".inp" || (abaqus_element_sets.empty() &&
+                                        abaqus_boundary_sets.empty()),
+                ExcMessage("Mesh/Abaqus element sets and Abaqus boundary sets "
+                           "are for .inp files, not '" +
+                           file + "'"));
     mesh_readers::Description mesh;
     if (extension == ".msh" || extension == ".geo")
       mesh = read_gmsh();
@@ -462,11 +467,6 @@ namespace knee_contact
                   ExcMessage("Mesh/File: '" + file +
                              "' has an extension knee_contact does not read "
                              "(.msh, .geo, .inp, .vtk)"));
-    AssertThrow(extension == ".inp" || (abaqus_element_sets.empty() &&
-                                        abaqus_boundary_sets.empty()),
-                ExcMessage("Mesh/Abaqus element sets and Abaqus boundary sets "
-                           "are for .inp files, not '" +
-                           file + "'"));
 
     // Cells turned the wrong way round (Gmsh keeps the orientation of a
     // clockwise curve loop, other tools list clockwise cells) are turned

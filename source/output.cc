@@ -485,6 +485,7 @@ namespace knee_contact
     summary["n_dofs"]               = results.n_dofs;
     summary["n_cells"]              = results.n_cells;
     summary["n_bodies"]             = results.n_bodies;
+    summary["elements"]             = results.elements;
     summary["applied_load"]         = {results.applied_load[0],
                                        results.applied_load[1]};
     summary["equilibrium_residual"] = results.equilibrium_residual;

@@ -1,0 +1,278 @@
+#!/usr/bin/python3
+"""One contact patch test read from Gmsh .msh, Abaqus .inp and VTK .vtk.
+
+tests/meshes/patch_stack.geo is meshed by gmsh (triangles; with
+-setnumber mixed 1 the upper block mostly quadrilaterals: a mixed mesh) and
+the .msh is written out again, by this script, as an Abaqus input deck
+(element sets per body, *Nset for the outer sides, element-face *Surface
+for the contact sides, named in the scene) and as a legacy VTK file
+(MaterialID of cells and of boundary lines). The scene is the contact patch
+test of tests/contact_patch_matching.prm (stiff block pressed on a soft one,
+sides sliding, node pairs on the matching interface).
+
+Asserted, per mesh (triangles, mixed):
+- each run passes its analytic checks (displacement, stress and contact
+  pressure to 1e-10 relative; exit code 0);
+- the three formats give the same results: every number of summary.json
+  (energy, max |u|, reactions, forces, peak pressures, tau_yy ranges, ...)
+  equal to 1e-12 relative to the largest of its kind, and the same
+  contact pairs and pressures (contact_blocks.csv, sorted by position).
+Reference: the analytic solution, and the .msh run for the other formats.
+Usage: mesh_formats.py KNEE_CONTACT
+"""
+import csv
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+GEO = os.path.join(HERE, "meshes", "patch_stack.geo")
+TOLERANCE = 1e-12
+
+SCENE = """
+subsection Mesh
+  set Source = file
+  set File   = {file}
+  set Abaqus element sets  = {element_sets}
+  set Abaqus boundary sets = {boundary_sets}
+end
+subsection Materials
+  set Number of materials = 2
+  subsection Material 0
+    set Material id     = 1
+    set Name            = soft
+    set Young's modulus = 1e9
+    set Poisson's ratio = 0.3
+  end
+  subsection Material 1
+    set Material id     = 2
+    set Name            = stiff
+    set Young's modulus = 3e9
+    set Poisson's ratio = 0.2
+  end
+end
+subsection Boundary conditions
+  set Number of conditions = 3
+  subsection Condition 0
+    set Boundary ids = 3
+    set Type         = displacement
+  end
+  subsection Condition 1
+    set Boundary ids = 1, 2
+    set Type         = sliding
+  end
+  subsection Condition 2
+    set Boundary ids = 4
+    set Type         = pressure
+    set Value        = 1e6
+  end
+end
+subsection Contact
+  set Number of interfaces = 1
+  subsection Interface 0
+    set Name               = blocks
+    set Slave boundary id  = 6
+    set Master boundary id = 5
+    set Pairing            = node-to-node
+  end
+end
+subsection Output
+  set Folder   = {folder}
+  set Pictures = {pictures}
+end
+subsection Verification
+  set Exact displacement     = 0; if(y < 1, -1e6*(1+0.3)*(1-2*0.3)/(1e9*(1-0.3))*y, \\
+    -1e6*(1+0.3)*(1-2*0.3)/(1e9*(1-0.3))*1 - 1e6*(1+0.2)*(1-2*0.2)/(3e9*(1-0.2))*(y - 1))
+  set Exact stress           = if(y < 1, -1e6*0.3/0.7, -1e6*0.2/0.8); -1e6; 0
+  set Exact contact pressure = 1e6
+  set Tolerance              = 1e-10
+end
+"""
+
+
+def read_msh22(path):
+    """Nodes {tag: (x, y)}, cells [(physical, [tags])], lines [(physical,
+    [tags])] of a Gmsh 2.2 ASCII file."""
+    nodes, cells, lines = {}, [], []
+    with open(path) as f:
+        text = f.read().split("\n")
+    i = text.index("$Nodes")
+    for row in text[i + 2:i + 2 + int(text[i + 1])]:
+        tag, x, y, _ = row.split()
+        nodes[int(tag)] = (float(x), float(y))
+    i = text.index("$Elements")
+    for row in text[i + 2:i + 2 + int(text[i + 1])]:
+        v = [int(w) for w in row.split()]
+        kind, n_tags = v[1], v[2]
+        physical, tags = v[3], v[3 + n_tags:]
+        if kind == 1:
+            lines.append((physical, tags))
+        elif kind in (2, 3):
+            cells.append((physical, tags))
+    return nodes, cells, lines
+
+
+def write_inp(path, nodes, cells, lines):
+    """Abaqus deck: bodies as element sets BODY_1, BODY_2 (also given in
+    *Element lines by type), outer sides as node sets, contact sides as
+    element-face surfaces."""
+    out = ["*Heading", "** written by tests/mesh_formats.py", "*Node"]
+    out += ["%d, %.17g, %.17g" % (t, x, y) for t, (x, y) in nodes.items()]
+    for n, kind in ((3, "CPE3"), (4, "CPE4R")):
+        numbered = [(e + 1, c) for e, c in enumerate(cells)
+                    if len(c[1]) == n]
+        if numbered:
+            out.append("*Element, type=%s" % kind)
+            out += ["%d, %s" % (e, ", ".join(map(str, c[1])))
+                    for e, c in numbered]
+    for body in sorted({c[0] for c in cells}):
+        out.append("*Elset, elset=BODY_%d" % body)
+        out += ["%d," % (e + 1) for e, c in enumerate(cells) if c[0] == body]
+    for side in sorted({l[0] for l in lines}):
+        edges = [l[1] for l in lines if l[0] == side]
+        if side in (5, 6):
+            out.append("*Surface, type=ELEMENT, name=SIDE_%d" % side)
+            for a, b in edges:
+                for e, (_, c) in enumerate(cells):
+                    for k in range(len(c)):
+                        if {c[k], c[(k + 1) % len(c)]} == {a, b}:
+                            out.append("%d, S%d" % (e + 1, k + 1))
+        else:
+            out.append("*Nset, nset=SIDE_%d" % side)
+            out += ["%d," % t for t in sorted({t for e in edges for t in e})]
+    out += ["*Solid Section, elset=BODY_1, material=SOFT",
+            "*Solid Section, elset=BODY_2, material=STIFF"]
+    with open(path, "w") as f:
+        f.write("\n".join(out) + "\n")
+
+
+def write_vtk(path, nodes, cells, lines):
+    index = {t: i for i, t in enumerate(nodes)}
+    all_cells = cells + lines
+    out = ["# vtk DataFile Version 3.0", "mesh_formats.py", "ASCII",
+           "DATASET UNSTRUCTURED_GRID", "POINTS %d double" % len(nodes)]
+    out += ["%.17g %.17g 0" % p for p in nodes.values()]
+    out.append("CELLS %d %d" % (len(all_cells),
+                                sum(len(c[1]) + 1 for c in all_cells)))
+    for _, tags in all_cells:
+        # Gmsh and VTK both run round a quadrilateral.
+        out.append(" ".join(map(str, [len(tags)] + [index[t] for t in tags])))
+    out.append("CELL_TYPES %d" % len(all_cells))
+    out += [str({2: 3, 3: 5, 4: 9}[len(c[1])]) for c in all_cells]
+    out += ["CELL_DATA %d" % len(all_cells), "SCALARS MaterialID int 1",
+            "LOOKUP_TABLE default"]
+    out += [str(c[0]) for c in all_cells]
+    with open(path, "w") as f:
+        f.write("\n".join(out) + "\n")
+
+
+def run(binary, folder, name, mesh, sets, pictures=False):
+    out = os.path.join(folder, name)
+    scene = os.path.join(folder, name + ".prm")
+    with open(scene, "w") as f:
+        f.write(SCENE.format(file=mesh, folder=out,
+                             pictures="true" if pictures else "false",
+                             element_sets=sets[0], boundary_sets=sets[1]))
+    result = subprocess.run([binary, scene], stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True)
+    if result.returncode != 0:
+        print(result.stdout[-3000:])
+        raise SystemExit("%s: exit code %d" % (name, result.returncode))
+    with open(os.path.join(out, "summary.json")) as f:
+        summary = json.load(f)
+    with open(os.path.join(out, "contact_blocks.csv")) as f:
+        rows = sorted((tuple(float(v) for v in row.values()
+                             if v.replace(".", "").replace("-", "")
+                             .replace("e", "").replace("+", "").isdigit())
+                       for row in csv.DictReader(f)))
+    return summary, rows
+
+
+def numbers(value, path=""):
+    """(path, number) for every number in summary.json but the timings."""
+    if isinstance(value, dict):
+        for k, v in value.items():
+            if k not in ("wall_time", "solver"):
+                yield from numbers(v, path + "/" + k)
+    elif isinstance(value, list):
+        for i, v in enumerate(value):
+            yield from numbers(v, path + "[%d]" % i)
+    elif isinstance(value, (int, float)) and not isinstance(value, bool):
+        yield path, float(value)
+
+
+def compare(name, reference, other):
+    failures = 0
+    a, b = dict(numbers(reference[0])), dict(numbers(other[0]))
+    assert a.keys() == b.keys(), (name, a.keys() ^ b.keys())
+    scale = max(abs(v) for v in a.values())
+    worst = 0
+    for key in a:
+        # Relative to the largest number of its kind (forces, stresses...).
+        kind = [abs(v) for k, v in a.items()
+                if k.split("/")[1] == key.split("/")[1]]
+        error = abs(a[key] - b[key]) / max(max(kind), 1e-300 * scale)
+        worst = max(worst, error)
+        if error > TOLERANCE:
+            print("FAIL %s: %s = %r, .msh gives %r" % (name, key, b[key],
+                                                     a[key]))
+            failures += 1
+    assert len(reference[1]) == len(other[1]) > 0
+    for ra, rb in zip(reference[1], other[1]):
+        rscale = max(max(abs(v) for v in ra), 1e-300)
+        worst = max(worst, max(abs(x - y) for x, y in zip(ra, rb)) / rscale)
+        if max(abs(x - y) for x, y in zip(ra, rb)) > TOLERANCE * rscale:
+            print("FAIL %s: contact row %r, .msh gives %r" % (name, rb, ra))
+            failures += 1
+    print("%s: %d numbers and %d contact pairs, largest relative "
+          "difference to .msh %.1e (tolerance %.0e)"
+          % (name, len(a), len(reference[1]), worst, TOLERANCE))
+    return failures
+
+
+def main():
+    binary = os.path.abspath(sys.argv[1])
+    failures = 0
+    with tempfile.TemporaryDirectory() as folder:
+        for kind, arguments in (("triangles", []),
+                                ("mixed", ["-setnumber", "mixed", "1"])):
+            msh = os.path.join(folder, kind + ".msh")
+            subprocess.run(["gmsh", "-2", "-format", "msh22", GEO, "-o", msh]
+                           + arguments, check=True, stdout=subprocess.DEVNULL,
+                           stderr=subprocess.DEVNULL)
+            nodes, cells, lines = read_msh22(msh)
+            sizes = {len(c[1]) for c in cells}
+            assert sizes == ({3} if kind == "triangles" else {3, 4}), sizes
+            inp = os.path.join(folder, kind + ".inp")
+            vtk = os.path.join(folder, kind + ".vtk")
+            write_inp(inp, nodes, cells, lines)
+            write_vtk(vtk, nodes, cells, lines)
+            no_sets = ("", "")
+            abaqus_sets = ("BODY_1: 1; BODY_2: 2",
+                           "; ".join("SIDE_%d: %d" % (i, i)
+                                     for i in range(1, 7)))
+            reference = run(binary, folder, kind + "_msh", msh, no_sets,
+                            pictures=True)
+            for picture in ("deformation.png", "stress_yy.png",
+                            "contact_pressure.png"):
+                assert os.path.getsize(os.path.join(
+                    folder, kind + "_msh", picture)) > 1000, picture
+            print("%s: %d cells read (%s), %d after splitting; analytic "
+                  "checks pass; pictures drawn"
+                  % (kind, len(cells), "P1" if kind == "triangles" else
+                     "mixed, split into quadrilaterals",
+                     reference[0]["n_cells"]))
+            failures += compare(kind + ".inp", reference,
+                                run(binary, folder, kind + "_inp", inp,
+                                    abaqus_sets))
+            failures += compare(kind + ".vtk", reference,
+                                run(binary, folder, kind + "_vtk", vtk,
+                                    no_sets))
+    if failures:
+        raise SystemExit("%d differences" % failures)
+
+
+if __name__ == "__main__":
+    main()
