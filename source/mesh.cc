@@ -130,24 +130,27 @@ namespace knee_contact
       prm.get("Rectangle cells") == "triangles" ? RectangleCells::triangles :
       prm.get("Rectangle cells") == "mixed"     ? RectangleCells::mixed :
                                                   RectangleCells::quadrilaterals;
-    for (auto [name, sets] :
-         {std::make_pair("Abaqus element sets", &abaqus_element_sets),
-          std::make_pair("Abaqus boundary sets", &abaqus_boundary_sets)})
-      {
-        const std::string parameter = "Mesh/" + std::string(name);
-        for (const auto &[set, id_text] :
-             input::split_named(prm.get(name), parameter, "NAME: id"))
-          {
-            const double id = input::to_double(id_text, parameter);
-            AssertThrow(id >= 0 && id < 255 && id == std::floor(id),
-                        ExcMessage(parameter + ": '" + id_text +
-                                   "' for set '" + set +
-                                   "' is not an id in 0..254"));
-            AssertThrow(sets->emplace(set, static_cast<unsigned int>(id)).second,
-                        ExcMessage(parameter + ": set '" + set +
-                                   "' is named twice"));
-          }
-      }
+    const auto read_sets = [](const std::string                   &text,
+                              const std::string                   &parameter,
+                              std::map<std::string, unsigned int> &sets) {
+      for (const auto &[set, id_text] :
+           input::split_named(text, parameter, "NAME: id"))
+        {
+          const double id = input::to_double(id_text, parameter);
+          AssertThrow(id >= 0 && id < 255 && id == std::floor(id),
+                      ExcMessage(parameter + ": '" + id_text + "' for set '" +
+                                 set + "' is not an id in 0..254"));
+          AssertThrow(sets.emplace(set, static_cast<unsigned int>(id)).second,
+                      ExcMessage(parameter + ": set '" + set +
+                                 "' is named twice"));
+        }
+    };
+    read_sets(prm.get("Abaqus element sets"),
+              "Mesh/Abaqus element sets",
+              abaqus_element_sets);
+    read_sets(prm.get("Abaqus boundary sets"),
+              "Mesh/Abaqus boundary sets",
+              abaqus_boundary_sets);
     rotation_degrees = prm.get_double("Rotation angle");
     n_refinements    = prm.get_integer("Global refinements");
     AssertThrow(std::isfinite(rotation_degrees),

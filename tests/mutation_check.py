@@ -45,6 +45,7 @@ EXEMPT = [
      "any size, so scaling the block cannot change the answer"),
     ("uniaxial_block_msh22.prm", r"^geometry:", "as uniaxial_block.prm"),
     ("uniaxial_block_msh41.prm", r"^geometry:", "as uniaxial_block.prm"),
+    ("uniaxial_block_p1.prm", r"^geometry:", "as uniaxial_block.prm"),
     ("sliding_rotated_square.prm", r"^geometry:",
      "homogeneous strain: u = eps x on a square of any size"),
     # Measured sensitivities (tests/knee_small.prm, knee_frontal_small.prm:
