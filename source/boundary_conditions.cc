@@ -150,12 +150,12 @@ namespace knee_contact
     if (!sliding.empty())
       {
         AffineConstraints<double> sliding_constraints;
-        VectorTools::compute_no_normal_flux_constraints(
-          dof_handler,
-          0,
-          sliding,
-          sliding_constraints,
-          elements::mapping(dof_handler));
+        VectorTools::compute_no_normal_flux_constraints(dof_handler,
+                                                        0,
+                                                        sliding,
+                                                        sliding_constraints,
+                                                        elements::mapping(
+                                                          dof_handler));
         sliding_constraints.close();
         constraints.merge(
           sliding_constraints,

@@ -123,13 +123,13 @@ namespace knee_contact
     prm.enter_subsection("Mesh");
     source = prm.get("Source") == "file" ? Source::file : Source::rectangles;
     file   = input::resolve_path(prm.get("File"), scene_file);
-    gmsh_arguments   = gmsh_input::arguments(prm.get("Gmsh arguments"));
-    gmsh_time_limit  = prm.get_double("Gmsh time limit");
-    split_triangles  = prm.get("Triangles") == "quadrilaterals";
+    gmsh_arguments  = gmsh_input::arguments(prm.get("Gmsh arguments"));
+    gmsh_time_limit = prm.get_double("Gmsh time limit");
+    split_triangles = prm.get("Triangles") == "quadrilaterals";
     rectangle_cells =
-      prm.get("Rectangle cells") == "triangles" ? RectangleCells::triangles :
-      prm.get("Rectangle cells") == "mixed"     ? RectangleCells::mixed :
-                                                  RectangleCells::quadrilaterals;
+      prm.get("Rectangle cells") == "triangles" ? RectangleCells::triangles
+      : prm.get("Rectangle cells") == "mixed"   ? RectangleCells::mixed
+                                              : RectangleCells::quadrilaterals;
     const auto read_sets = [](const std::string                   &text,
                               const std::string                   &parameter,
                               std::map<std::string, unsigned int> &sets) {
@@ -310,15 +310,15 @@ namespace knee_contact
   {
     // The Jacobian of a bilinear quadrilateral is positive everywhere iff
     // the cross products of the edges at all four corners are (deal.II's
-    // vertex order 0 1 3 2 runs counter-clockwise); a triangle's at any. Checked on every mesh
-    // the program solves on: refinement on a circle that does not fit the
-    // vertices can fold cells.
+    // vertex order 0 1 3 2 runs counter-clockwise); a triangle's at any.
+    // Checked on every mesh the program solves on: refinement on a circle that
+    // does not fit the vertices can fold cells.
     for (const auto &cell : triangulation.active_cell_iterators())
       {
         // A triangle's vertices 0 1 2 run counter-clockwise too.
         const std::array<unsigned int, 4> ring =
-          cell->n_vertices() == 3 ? std::array<unsigned int, 4>{{0, 1, 2}} :
-                                    std::array<unsigned int, 4>{{0, 1, 3, 2}};
+          cell->n_vertices() == 3 ? std::array<unsigned int, 4>{{0, 1, 2}}
+                                  : std::array<unsigned int, 4>{{0, 1, 3, 2}};
         const unsigned int n = cell->n_vertices();
         for (unsigned int k = 0; k < n; ++k)
           {
@@ -451,8 +451,8 @@ namespace knee_contact
   MeshInput::read_file(Triangulation<2> &triangulation) const
   {
     const std::string extension = std::filesystem::path(file).extension();
-    AssertThrow(extension == ".inp" || (abaqus_element_sets.empty() &&
-                                        abaqus_boundary_sets.empty()),
+    AssertThrow(extension == ".inp" ||
+                  (abaqus_element_sets.empty() && abaqus_boundary_sets.empty()),
                 ExcMessage("Mesh/Abaqus element sets and Abaqus boundary sets "
                            "are for .inp files, not '" +
                            file + "'"));
@@ -510,9 +510,9 @@ namespace knee_contact
     catch (const std::exception &exc)
       {
         AssertThrow(false,
-                    ExcMessage((source == Source::file ?
-                                  "Mesh/File: '" + file + "'" :
-                                  std::string("Mesh/Rectangles: the mesh")) +
+                    ExcMessage((source == Source::file
+                                  ? "Mesh/File: '" + file + "'"
+                                  : std::string("Mesh/Rectangles: the mesh")) +
                                " is not a valid mesh (" +
                                input::one_line(exc.what()) + ")"));
       }
@@ -577,9 +577,8 @@ namespace knee_contact
               // or one quadrilateral.
               for (const auto &corners :
                    split ? std::vector<std::vector<unsigned int>>{{a, b, d},
-                                                                  {a, d, c}} :
-                           std::vector<std::vector<unsigned int>>{
-                             {a, b, c, d}})
+                                                                  {a, d, c}}
+                         : std::vector<std::vector<unsigned int>>{{a, b, c, d}})
                 {
                   CellData<2> cell(corners.size());
                   cell.vertices    = corners;

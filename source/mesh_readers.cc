@@ -9,8 +9,8 @@
 #include <filesystem>
 #include <fstream>
 #include <set>
-#include <stdexcept>
 #include <sstream>
+#include <stdexcept>
 
 namespace knee_contact
 {
@@ -61,10 +61,9 @@ namespace knee_contact
         [[noreturn]] void
         fail(const std::string &what) const
         {
-          throw std::runtime_error(input::cap("Mesh/File: '" + file +
-                                              "' line " +
-                                              std::to_string(number) + ": " +
-                                              what));
+          throw std::runtime_error(
+            input::cap("Mesh/File: '" + file + "' line " +
+                       std::to_string(number) + ": " + what));
         }
 
         const std::string file;
@@ -196,17 +195,17 @@ namespace knee_contact
       std::map<long long, std::vector<long long>> elements;
       std::map<std::string, std::set<long long>>  elsets, nsets;
       std::map<std::string, std::vector<std::pair<std::string, unsigned int>>>
-                               surfaces;     // (element or elset, face)
+                               surfaces;      // (element or elset, face)
       std::set<std::string>    node_surfaces; // TYPE=NODE: named as node sets
-      std::vector<std::string> sections;     // element sets, in file order
+      std::vector<std::string> sections;      // element sets, in file order
       // At most one number per byte of the file: counts beyond that are not
       // a mesh but an attack on memory.
       const std::uintmax_t limit = lines.size;
 
-      std::string line;
-      std::string block; // the keyword whose data lines follow
-      std::string block_set;
-      bool        generate = false;
+      std::string  line;
+      std::string  block; // the keyword whose data lines follow
+      std::string  block_set;
+      bool         generate        = false;
       unsigned int n_element_nodes = 0;
       while (lines.next(line))
         {
@@ -331,8 +330,8 @@ namespace knee_contact
                     lines.fail("element " + values[0] + " refers to node " +
                                values[k] + ", which no *Node line gives");
                 }
-              if (std::set<long long>(element.begin(), element.end())
-                    .size() != element.size())
+              if (std::set<long long>(element.begin(), element.end()).size() !=
+                  element.size())
                 lines.fail("element " + values[0] + " names a node twice");
               if (!elements.emplace(id, element).second)
                 lines.fail("element " + values[0] + " appears twice");
@@ -348,12 +347,11 @@ namespace knee_contact
                     lines.fail("GENERATE needs 'first, last[, step]'");
                   const long long first = to_integer(values[0], lines),
                                   last  = to_integer(values[1], lines),
-                                  step  = values.size() == 3 ?
-                                            to_integer(values[2], lines) :
-                                            1;
+                                  step  = values.size() == 3
+                                            ? to_integer(values[2], lines)
+                                            : 1;
                   if (step <= 0 || last < first ||
-                      (last - first) / step >
-                        static_cast<long long>(limit))
+                      (last - first) / step > static_cast<long long>(limit))
                     lines.fail("GENERATE range '" + text +
                                "' is empty or too long");
                   for (long long i = first; i <= last; i += step)
@@ -362,13 +360,15 @@ namespace knee_contact
               else
                 for (const auto &value : values)
                   {
-                    if (!value.empty() && !std::isdigit(static_cast<unsigned char>(value[0])))
+                    if (!value.empty() &&
+                        !std::isdigit(static_cast<unsigned char>(value[0])))
                       {
                         // A set made of other sets.
                         const auto &sets = block == "*ELSET" ? elsets : nsets;
                         const auto  it   = sets.find(upper(value));
                         if (it == sets.end())
-                          lines.fail("set '" + value + "' is not defined above");
+                          lines.fail("set '" + value +
+                                     "' is not defined above");
                         set.insert(it->second.begin(), it->second.end());
                       }
                     else
@@ -422,12 +422,12 @@ namespace knee_contact
                     ExcMessage("Mesh/Abaqus element sets: element " +
                                std::to_string(element.first) + " of '" + file +
                                "' is in no set given a material id (" +
-                               (element_sets.empty() ?
-                                  "no *Solid Section names it" :
-                                  "name its set in the scene") +
+                               (element_sets.empty()
+                                  ? "no *Solid Section names it"
+                                  : "name its set in the scene") +
                                ")"));
 
-      Description mesh;
+      Description                       mesh;
       std::map<long long, unsigned int> vertex_of_node;
       for (const auto &[id, p] : nodes)
         {
@@ -440,18 +440,18 @@ namespace knee_contact
           for (unsigned int k = 0; k < element.size(); ++k)
             // Abaqus runs round the quadrilateral; deal.II's order is
             // lexicographic (0 1 3 2 round it).
-            cell.vertices[element.size() == 4 ? (k == 2 ? 3 :
-                                                 k == 3 ? 2 :
-                                                          k) :
-                                                k] =
-              vertex_of_node[element[k]];
+            cell.vertices[element.size() == 4 ? (k == 2   ? 3
+                                                 : k == 3 ? 2
+                                                          : k)
+                                              : k] = vertex_of_node[element[k]];
           cell.material_id = material[id];
           mesh.cells.push_back(cell);
         }
 
       // Boundary ids: element faces of surfaces, or edges with both nodes
       // in a node set; only faces on the boundary (one element) count.
-      std::map<std::pair<long long, long long>, unsigned int> n_elements_of_edge;
+      std::map<std::pair<long long, long long>, unsigned int>
+        n_elements_of_edge;
       for (const auto &[id, element] : elements)
         for (unsigned int k = 0; k < element.size(); ++k)
           {
@@ -481,14 +481,13 @@ namespace knee_contact
                 for (const long long e : owners)
                   {
                     const auto element = elements.find(e);
-                    AssertThrow(element != elements.end() &&
-                                  face < element->second.size(),
-                                ExcMessage("Mesh/File: '" + file +
-                                           "': surface '" + name +
-                                           "' names face S" +
-                                           std::to_string(face + 1) +
-                                           " of element " + std::to_string(e) +
-                                           ", which has no such face"));
+                    AssertThrow(
+                      element != elements.end() &&
+                        face < element->second.size(),
+                      ExcMessage("Mesh/File: '" + file + "': surface '" + name +
+                                 "' names face S" + std::to_string(face + 1) +
+                                 " of element " + std::to_string(e) +
+                                 ", which has no such face"));
                     const auto edge = face_nodes(element->second, face);
                     boundary_id[std::minmax(edge.first, edge.second)] = id;
                   }
@@ -563,7 +562,7 @@ namespace knee_contact
             words.emplace_back(word, lines.number);
         }
       std::size_t at   = 0;
-      const auto  word = [&](const std::string &what) -> const std::string & {
+      const auto  word = [&](const std::string &what) -> const std::string  &{
         if (at >= words.size())
           lines.fail("the file ends where " + what + " should be");
         lines.number = words[at].second;
@@ -589,8 +588,8 @@ namespace knee_contact
       for (std::size_t i = 0; i < 3 * n_points; ++i)
         to_number(word("a coordinate"), lines);
       keyword("CELLS");
-      const std::size_t n_cells = count("cell count");
-      const std::size_t n_ints  = count("cell list size");
+      const std::size_t        n_cells = count("cell count");
+      const std::size_t        n_ints  = count("cell list size");
       std::vector<std::size_t> sizes;
       std::size_t              used = 0;
       for (std::size_t c = 0; c < n_cells; ++c)
@@ -693,8 +692,8 @@ namespace knee_contact
           const auto &v = cell.vertices;
           // Corners in counter-clockwise order.
           std::vector<unsigned int> ring =
-            v.size() == 3 ? std::vector<unsigned int>{v[0], v[1], v[2]} :
-                            std::vector<unsigned int>{v[0], v[1], v[3], v[2]};
+            v.size() == 3 ? std::vector<unsigned int>{v[0], v[1], v[2]}
+                          : std::vector<unsigned int>{v[0], v[1], v[3], v[2]};
           Point<2> centre;
           for (const unsigned int k : ring)
             centre += mesh.vertices[k] / double(ring.size());

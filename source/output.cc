@@ -337,8 +337,8 @@ namespace knee_contact
         // quadrilateral, 0 1 2 on a triangle.
         const bool triangle = cell->n_vertices() == 3;
         for (const unsigned int v :
-             triangle ? std::array<unsigned int, 4>{{0, 1, 2, 2}} :
-                        std::array<unsigned int, 4>{{0, 1, 3, 2}})
+             triangle ? std::array<unsigned int, 4>{{0, 1, 2, 2}}
+                      : std::array<unsigned int, 4>{{0, 1, 3, 2}})
           {
             data.push_back(cell->vertex(v)[0]);
             data.push_back(cell->vertex(v)[1]);

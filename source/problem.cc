@@ -1,5 +1,5 @@
-#include <knee_contact/elements.h>
 #include <knee_contact/elasticity.h>
+#include <knee_contact/elements.h>
 #include <knee_contact/input.h>
 #include <knee_contact/problem.h>
 #include <knee_contact/rigid_modes.h>

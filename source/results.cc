@@ -27,8 +27,8 @@ namespace knee_contact
                   const ContactSolution           &contact)
   {
     Results results;
-    results.n_dofs  = dof_handler.n_dofs();
-    results.n_cells = dof_handler.get_triangulation().n_active_cells();
+    results.n_dofs   = dof_handler.n_dofs();
+    results.n_cells  = dof_handler.get_triangulation().n_active_cells();
     results.elements = elements::name(dof_handler.get_fe().reference_cell());
     results.n_bodies =
       body_of_cell.empty()

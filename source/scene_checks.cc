@@ -3,10 +3,9 @@
 #include <deal.II/base/bounding_box.h>
 #include <deal.II/base/quadrature_lib.h>
 
-#include <deal.II/fe/mapping.h>
-
 #include <deal.II/lac/vector.h>
 
+#include <deal.II/fe/mapping.h>
 #include <deal.II/grid/grid_tools.h>
 #include <deal.II/numerics/rtree.h>
 
@@ -97,8 +96,9 @@ namespace knee_contact
           // The Gauss points, mapped as the assembly maps them.
           const auto &mapping =
             cell->reference_cell().get_default_linear_mapping<2, 2>();
-          for (const auto &xi :
-               cell->reference_cell().get_gauss_type_quadrature<2>(2).get_points())
+          for (const auto &xi : cell->reference_cell()
+                                  .get_gauss_type_quadrature<2>(2)
+                                  .get_points())
             check(force,
                   mapping.transform_unit_to_real_cell(cell, xi),
                   parameter,

@@ -1,5 +1,5 @@
-#include <knee_contact/input.h>
 #include <knee_contact/elements.h>
+#include <knee_contact/input.h>
 #include <knee_contact/verification.h>
 
 #include <deal.II/base/quadrature_lib.h>

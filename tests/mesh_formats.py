@@ -264,9 +264,13 @@ def main():
                   % (kind, len(cells), "P1" if kind == "triangles" else
                      "mixed, split into quadrilaterals",
                      reference[0]["n_cells"]))
-            failures += compare(kind + ".inp", reference,
-                                run(binary, folder, kind + "_inp", inp,
-                                    abaqus_sets))
+            abaqus = run(binary, folder, kind + "_inp", inp, abaqus_sets,
+                         pictures=True)
+            for picture in ("deformation.png", "stress_yy.png",
+                            "contact_pressure.png"):
+                assert os.path.getsize(os.path.join(
+                    folder, kind + "_inp", picture)) > 1000, picture
+            failures += compare(kind + ".inp", reference, abaqus)
             failures += compare(kind + ".vtk", reference,
                                 run(binary, folder, kind + "_vtk", vtk,
                                     no_sets))

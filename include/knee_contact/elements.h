@@ -4,10 +4,8 @@
 #include <deal.II/base/quadrature.h>
 
 #include <deal.II/dofs/dof_handler.h>
-
 #include <deal.II/fe/fe.h>
 #include <deal.II/fe/mapping.h>
-
 #include <deal.II/grid/reference_cell.h>
 #include <deal.II/grid/tria.h>
 

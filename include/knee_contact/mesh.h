@@ -97,8 +97,8 @@ namespace knee_contact
       triangles,
       mixed
     } rectangle_cells = RectangleCells::quadrilaterals;
-    std::map<std::string, unsigned int>    abaqus_element_sets;
-    std::map<std::string, unsigned int>    abaqus_boundary_sets;
+    std::map<std::string, unsigned int> abaqus_element_sets;
+    std::map<std::string, unsigned int> abaqus_boundary_sets;
 
   public:
     /**

@@ -219,13 +219,13 @@ namespace knee_contact
     Verification       verification;
     Refinement         refinement;
 
-    Triangulation<2>          triangulation;
+    Triangulation<2> triangulation;
     // FE_Q(1)^2 or FE_SimplexP(1)^2, by the mesh's cells (make_mesh).
     std::unique_ptr<FiniteElement<2>> fe;
-    DoFHandler<2>             dof_handler;
-    std::vector<unsigned int> body_of_cell;
-    unsigned int              n_bodies = 0;
-    std::vector<std::string>  body_names;
+    DoFHandler<2>                     dof_handler;
+    std::vector<unsigned int>         body_of_cell;
+    unsigned int                      n_bodies = 0;
+    std::vector<std::string>          body_names;
 
     AffineConstraints<double> constraints;
     std::vector<ContactPair>  contact_pairs;

@@ -42,10 +42,10 @@ namespace knee_contact
    */
   struct Results
   {
-    unsigned int n_dofs   = 0;
-    unsigned int n_cells  = 0;
+    unsigned int n_dofs  = 0;
+    unsigned int n_cells = 0;
     // The elements solved with: "Q1" or "P1".
-    std::string elements;
+    std::string  elements;
     unsigned int n_bodies = 0;
     /** Reaction force per Gamma_u/Gamma_o boundary id [N/m]. */
     std::map<types::boundary_id, Tensor<1, 2>> reactions;
