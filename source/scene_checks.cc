@@ -96,9 +96,11 @@ namespace knee_contact
           // The Gauss points, mapped as the assembly maps them.
           const auto &mapping =
             cell->reference_cell().get_default_linear_mapping<2, 2>();
-          for (const auto &xi : cell->reference_cell()
-                                  .get_gauss_type_quadrature<2>(2)
-                                  .get_points())
+          // (The rule is kept in a named variable: a range-for over a
+          // member of a temporary would read freed stack memory.)
+          const Quadrature<2> cell_points =
+            cell->reference_cell().get_gauss_type_quadrature<2>(2);
+          for (const auto &xi : cell_points.get_points())
             check(force,
                   mapping.transform_unit_to_real_cell(cell, xi),
                   parameter,
