@@ -9,10 +9,11 @@ cd "$(dirname "$0")"
 # Boost, muparser and MPI; numdiff, perl and mpiexec serve deal.II's test
 # machinery; gmsh meshes .geo scenes; OpenBLAS makes UMFPACK 5-6x faster than
 # the reference BLAS; nlohmann-json writes summary.json with real numbers;
-# the condensed contact solver calls CHOLMOD (libsuitesparse-dev) and METIS.
+# the condensed contact solver calls CHOLMOD (libsuitesparse-dev) and METIS;
+# zlib inflates compressed VTU meshes.
 packages="cmake make g++ libdeal.ii-dev numdiff perl openmpi-bin gmsh
           libopenblas0-pthread nlohmann-json3-dev python3-matplotlib
-          libsuitesparse-dev libmetis-dev"
+          libsuitesparse-dev libmetis-dev zlib1g-dev"
 missing=""
 for package in $packages; do
   dpkg-query -W -f='${Status}' "$package" 2>/dev/null |

@@ -465,11 +465,15 @@ namespace knee_contact
                                        abaqus_boundary_sets);
     else if (extension == ".vtk")
       mesh = read_vtk();
+    else if (extension == ".vtu")
+      mesh = mesh_readers::read_vtu(file);
+    else if (extension == ".ucd")
+      mesh = mesh_readers::read_ucd(file);
     else
       AssertThrow(false,
                   ExcMessage("Mesh/File: '" + file +
                              "' has an extension knee_contact does not read "
-                             "(.msh, .geo, .inp, .vtk)"));
+                             "(.msh, .geo, .inp, .vtk, .vtu, .ucd)"));
 
     // Cells turned the wrong way round (Gmsh keeps the orientation of a
     // clockwise curve loop, other tools list clockwise cells) are turned

@@ -48,6 +48,28 @@ namespace knee_contact
                 const std::map<std::string, unsigned int> &boundary_sets);
 
     /**
+     * Read an AVS UCD file (.ucd, .inp of AVS is not accepted: .inp means
+     * Abaqus here): nodes, then cells of type tri and quad (material id) and
+     * line (boundary id); pt cells and data sections are ignored. Written by
+     * hand: deal.II 9.4's read_ucd reads quadrilaterals only and trusts
+     * counts and node numbers.
+     */
+    Description
+    read_ucd(const std::string &file);
+
+    /**
+     * Read a VTK XML unstructured grid (.vtu) of one piece: Points, Cells
+     * (connectivity, offsets, types: vertices, lines, triangles,
+     * quadrilaterals) and the cell field MaterialID (material ids of cells,
+     * boundary ids of lines), with DataArrays in ascii, inline binary
+     * (base64) or raw appended format, uncompressed or zlib-compressed, as
+     * ParaView, VTK and meshio write them. Written by hand: deal.II 9.4's
+     * read_vtu reads only the files deal.II itself wrote.
+     */
+    Description
+    read_vtu(const std::string &file);
+
+    /**
      * Check a legacy ASCII VTK file (DATASET UNSTRUCTURED_GRID) against its
      * own counts before deal.II's GridIn::read_vtk, which trusts them:
      * POINTS, CELLS (vertices, lines, triangles, quadrilaterals), CELL_TYPES

@@ -1,0 +1,128 @@
+#!/usr/bin/python3
+"""Hostile mesh files for every reader knee_contact has written by hand.
+
+The contact patch mesh of tests/meshes/patch_stack.geo (a mixed mesh) is
+written in every format mesh_formats.py writes (.msh, our and Gmsh's .inp,
+.vtk, .ucd, .vtu in five encodings); each file is then damaged with a fixed
+seed: cut at several offsets, bytes overwritten by random bytes, a digit
+changed into a large or negative number, lines dropped or repeated. Every
+damaged file is run through the scene; as in fuzz.py, each run must end
+within a time limit with exit code 0-3, never a crash, an internal error, a
+sanitizer report or a hang, and a refusal (exit 1) must be one line
+"knee_contact: error: ...". A damaged file may still be a valid mesh (a
+changed coordinate): then the run ends with 0, 2 or 3 and that is fine.
+
+Usage: reader_fuzz.py KNEE_CONTACT VARIANTS_PER_FILE
+"""
+import concurrent.futures
+import os
+import random
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import fuzz  # noqa: E402
+import mesh_formats  # noqa: E402
+
+SETS = {".inp": ("BODY_1: 1; BODY_2: 2",
+                 "; ".join("SIDE_%d: %d" % (i, i) for i in range(1, 7))),
+        "_gmsh.inp": ("PhysicalSurface1: 1; PhysicalSurface2: 2",
+                      "; ".join("PhysicalLine%d: %d" % (i, i)
+                                for i in range(1, 7)))}
+
+
+def damage(data, rng):
+    """One damaged copy of data (bytes) and what was done."""
+    kind = rng.randrange(4)
+    if kind == 0:
+        cut = rng.randrange(len(data))
+        return data[:cut], "cut at byte %d" % cut
+    if kind == 1:
+        at = rng.randrange(len(data))
+        n = rng.randint(1, 8)
+        noise = bytes(rng.randrange(256) for _ in range(n))
+        return data[:at] + noise + data[at + n:], "%d random bytes at %d" % (
+            n, at)
+    if kind == 2:
+        digits = [m.start() for m in re.finditer(rb"\d", data)]
+        at = rng.choice(digits)
+        value = rng.choice([b"99999999999", b"-1", b"4294967296", b"0"])
+        return data[:at] + value + data[at + 1:], "digit at %d -> %s" % (
+            at, value.decode())
+    lines = data.split(b"\n")
+    i = rng.randrange(len(lines))
+    if rng.random() < 0.5:
+        del lines[i]
+        return b"\n".join(lines), "line %d dropped" % (i + 1)
+    lines.insert(i, lines[i])
+    return b"\n".join(lines), "line %d repeated" % (i + 1)
+
+
+def main():
+    program, per_file = os.path.abspath(sys.argv[1]), int(sys.argv[2])
+    rng = random.Random(20261123)
+    cases = []
+    with tempfile.TemporaryDirectory() as folder:
+        msh = os.path.join(folder, "mesh.msh")
+        subprocess.run(["gmsh", "-2", "-format", "msh22", mesh_formats.GEO,
+                        "-o", msh, "-setnumber", "mixed", "1"], check=True,
+                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        gmsh_inp = os.path.join(folder, "mesh_gmsh.inp")
+        subprocess.run(["gmsh", "-2", "-format", "inp", mesh_formats.GEO,
+                        "-o", gmsh_inp, "-setnumber", "mixed", "1"],
+                       check=True, stdout=subprocess.DEVNULL,
+                       stderr=subprocess.DEVNULL)
+        nodes, cells, lines = mesh_formats.read_msh22(msh)
+        files = {".msh": msh, "_gmsh.inp": gmsh_inp}
+        for suffix, write in ((".inp", mesh_formats.write_inp),
+                              (".vtk", mesh_formats.write_vtk),
+                              (".ucd", mesh_formats.write_ucd)):
+            files[suffix] = os.path.join(folder, "mesh" + suffix)
+            write(files[suffix], nodes, cells, lines)
+        for encoding in ("ascii", "binary", "binary1", "zlib", "appended"):
+            suffix = "_%s.vtu" % encoding
+            files[suffix] = os.path.join(folder, "mesh" + suffix)
+            mesh_formats.write_vtu(files[suffix], nodes, cells, lines,
+                                   encoding)
+        for suffix, path in sorted(files.items()):
+            data = open(path, "rb").read()
+            element_sets, boundary_sets = SETS.get(suffix, ("", ""))
+            extension = suffix[suffix.rindex("."):]
+            scene = mesh_formats.SCENE.format(
+                file="@WORK@/mesh" + extension, folder="@WORK@/out",
+                pictures="false", element_sets=element_sets,
+                boundary_sets=boundary_sets)
+            for _ in range(per_file):
+                damaged, what = damage(data, rng)
+                cases.append(("mesh%s: %s" % (suffix, what), scene,
+                              ("mesh" + extension, damaged)))
+
+    def one(case):
+        name, text, (file_name, data) = case
+        work = tempfile.mkdtemp(prefix="knee_reader_fuzz_")
+        try:
+            with open(os.path.join(work, file_name), "wb") as f:
+                f.write(data)
+            return fuzz.run(program, name, text.replace("@WORK@", work),
+                            work)
+        finally:
+            shutil.rmtree(work, ignore_errors=True)
+
+    with concurrent.futures.ThreadPoolExecutor(2) as pool:
+        outcomes = list(pool.map(one, cases))
+    failures = [f for f in outcomes if isinstance(f, str)]
+    for code in (0, 1, 2, 3):
+        print("exit code %d: %d variants" % (code, outcomes.count(code)))
+    for f in failures:
+        print("FAIL:", f)
+    print("%d of %d damaged mesh files handled (exit 0-3, one error line "
+          "for exit 1, no crash or hang)" % (len(cases) - len(failures),
+                                             len(cases)))
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
