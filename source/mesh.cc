@@ -162,6 +162,10 @@ namespace knee_contact
                     ExcMessage("Mesh/File: no file given for Source = file"));
         AssertThrow(std::ifstream(file).good(),
                     ExcMessage("Mesh/File: cannot open '" + file + "'"));
+        // A folder opens as a stream on Linux but has no size or lines.
+        AssertThrow(std::filesystem::is_regular_file(file),
+                    ExcMessage("Mesh/File: '" + file +
+                               "' is not a file (a folder?)"));
       }
     else
       for (const auto &text : input::split(prm.get("Rectangles"), ';'))

@@ -763,9 +763,10 @@ namespace knee_contact
             }
           else
             {
-              std::string bytes;
+              std::string       bytes;
+              const std::size_t expected = n * sizes.at(type);
               if (format == "binary")
-                bytes = decode(trim_all(array.data()), name);
+                bytes = decode(trim_all(array.data()), name, expected);
               else if (format == "appended")
                 {
                   const std::string offset_text =
@@ -782,7 +783,7 @@ namespace knee_contact
                   if (offset >= appended.size())
                     fail("DataArray '" + name + "': offset " + offset_text +
                          " is beyond the appended data");
-                  bytes = unpack(appended.substr(offset), name);
+                  bytes = unpack(appended.substr(offset), name, expected);
                 }
               else
                 fail("DataArray '" + name + "' has format '" + format +
@@ -861,7 +862,9 @@ namespace knee_contact
 
         /** Inline binary: base64, the header apart if compressed. */
         std::string
-        decode(const std::string &text, const std::string &name) const
+        decode(const std::string &text,
+               const std::string &name,
+               const std::size_t  expected) const
         {
           const std::size_t size       = header_64 ? 8 : 4;
           const auto        b64_length = [](const std::size_t bytes) {
@@ -876,8 +879,9 @@ namespace knee_contact
                   text[header_length - 1] == '=')
                 return unpack(base64(text.substr(0, header_length), name) +
                                 base64(text.substr(header_length), name),
-                              name);
-              return unpack(base64(text, name), name);
+                              name,
+                              expected);
+              return unpack(base64(text, name), name, expected);
             }
           const std::string first =
             base64(text.substr(0, b64_length(3 * size)), name);
@@ -891,16 +895,21 @@ namespace knee_contact
           return unpack(base64(text.substr(0, header_length), name) +
                           base64(text.substr(header_length), name),
                         name,
+                        expected,
                         (3 + n_blocks) * size);
         }
 
         /**
          * Header and data (raw bytes): the data, inflated if compressed.
+         * @p expected: the bytes the array must hold (compressed data must
+         * say exactly that before anything is inflated, so that a header
+         * cannot ask for memory the file does not justify).
          * @p header_bytes: the length of a header padded by base64.
          */
         std::string
         unpack(const std::string &bytes,
                const std::string &name,
+               const std::size_t  expected,
                std::size_t        header_bytes = 0) const
         {
           const std::size_t size = header_64 ? 8 : 4;
@@ -918,13 +927,21 @@ namespace knee_contact
           if (n_blocks > bytes.size() || block > (std::uint64_t(1) << 31) ||
               last > block)
             fail("DataArray '" + name + "' has an impossible header");
+          const std::uint64_t declared =
+            n_blocks == 0 ? 0
+                          : (n_blocks - 1) * block + (last != 0 ? last : block);
+          if (declared != expected)
+            fail("DataArray '" + name + "' holds " + std::to_string(declared) +
+                 " bytes, " + std::to_string(expected) + " expected");
           std::size_t at =
             std::max<std::size_t>(header_bytes, (3 + n_blocks) * size);
+          if (at > bytes.size())
+            fail("DataArray '" + name + "' is cut off");
           std::string result;
           for (std::uint64_t b = 0; b < n_blocks; ++b)
             {
               const std::uint64_t length = header_item(bytes, 3 + b);
-              if (at + length > bytes.size())
+              if (length > bytes.size() - at)
                 fail("DataArray '" + name + "' is cut off");
               uLongf inflated = (b + 1 == n_blocks && last != 0) ? last : block;
               std::string out(inflated, '\0');
@@ -1087,7 +1104,7 @@ namespace knee_contact
       const auto offsets     = array("Cells", "offsets", n_cells, true);
       const auto types       = array("Cells", "types", n_cells, true);
       const auto n_connected = n_cells == 0 ? 0. : offsets.back();
-      if (n_connected < 0 || n_connected > size)
+      if (!(n_connected >= 0 && n_connected <= size))
         fail("the last offset is not a connectivity length");
       const auto connectivity =
         array("Cells", "connectivity", std::size_t(n_connected), true);
@@ -1113,6 +1130,9 @@ namespace knee_contact
                                                             {3, 2},
                                                             {5, 3},
                                                             {9, 4}};
+          if (types[c] != std::floor(types[c]) || end != std::floor(end))
+            fail("cell " + std::to_string(c) +
+                 ": a type or an offset that is not an integer");
           if (n_vertices.count(types[c]) == 0)
             fail("cell " + std::to_string(c) + " has VTK type " +
                  text_of(types[c]) +

@@ -68,12 +68,17 @@ for phase in in_solve writing_output drawing; do
 done
 
 # Two runs on one folder: the second is refused with one line while the
-# first lives, and the first still completes.
+# first lives, and the first still completes. The first is stopped
+# (SIGSTOP) while the second runs, so that it cannot finish first on a
+# loaded machine (it holds the folder from its start; CI once saw the
+# second run start after the first had ended).
 "$program" scene.prm >run.log 2>run.err &
 pid=$!
 wait_for 60 in_solve || fail "concurrent: the first run never reached the solve"
+kill -STOP $pid
 "$program" scene.prm >second.log 2>second.err
 code=$?
+kill -CONT $pid
 [ $code -eq 1 ] || fail "concurrent: the second run exited $code, expected 1"
 grep -q "another knee_contact run is writing" second.err ||
   fail "concurrent: unexpected message: $(cat second.err)"
