@@ -186,6 +186,36 @@ namespace knee_contact
       {
         return {nodes[k], nodes[(k + 1) % nodes.size()]};
       }
+
+      /**
+       * Add a triangle or quadrilateral whose @p vertices run round it, as
+       * Abaqus, UCD and VTK list them; deal.II's order is lexicographic
+       * (0 1 3 2 round a quadrilateral).
+       */
+      void
+      add_cell(Description              &mesh,
+               std::vector<unsigned int> vertices,
+               const types::material_id  material_id)
+      {
+        if (vertices.size() == 4)
+          std::swap(vertices[2], vertices[3]);
+        CellData<2> cell(vertices.size());
+        cell.vertices    = vertices;
+        cell.material_id = material_id;
+        mesh.cells.push_back(cell);
+      }
+
+      void
+      add_boundary_line(Description             &mesh,
+                        const unsigned int       a,
+                        const unsigned int       b,
+                        const types::boundary_id boundary_id)
+      {
+        CellData<1> line;
+        line.vertices    = {a, b};
+        line.boundary_id = boundary_id;
+        mesh.subcells.boundary_lines.push_back(line);
+      }
     } // namespace
 
 
@@ -465,16 +495,10 @@ namespace knee_contact
         }
       for (const auto &[id, element] : elements)
         {
-          CellData<2> cell(element.size());
-          for (unsigned int k = 0; k < element.size(); ++k)
-            // Abaqus runs round the quadrilateral; deal.II's order is
-            // lexicographic (0 1 3 2 round it).
-            cell.vertices[element.size() == 4 ? (k == 2   ? 3
-                                                 : k == 3 ? 2
-                                                          : k)
-                                              : k] = vertex_of_node[element[k]];
-          cell.material_id = material[id];
-          mesh.cells.push_back(cell);
+          std::vector<unsigned int> vertices;
+          for (const long long node : element)
+            vertices.push_back(vertex_of_node[node]);
+          add_cell(mesh, vertices, material[id]);
         }
 
       // Boundary ids: element faces of surfaces, or edges with both nodes
@@ -564,11 +588,10 @@ namespace knee_contact
                                  std::to_string(edge.second) +
                                  " of boundary id " + std::to_string(id) +
                                  " lies between two elements"));
-          CellData<1> boundary_line;
-          boundary_line.vertices    = {vertex_of_node[edge.first],
-                                       vertex_of_node[edge.second]};
-          boundary_line.boundary_id = id;
-          mesh.subcells.boundary_lines.push_back(boundary_line);
+          add_boundary_line(mesh,
+                            vertex_of_node[edge.first],
+                            vertex_of_node[edge.second],
+                            id);
         }
       GridTools::delete_unused_vertices(mesh.vertices,
                                         mesh.cells,
@@ -668,23 +691,9 @@ namespace knee_contact
               vertices.size())
             lines.fail("cell " + words[0] + " names a node twice");
           if (type == "line")
-            {
-              CellData<1> boundary_line;
-              boundary_line.vertices    = {vertices[0], vertices[1]};
-              boundary_line.boundary_id = id;
-              mesh.subcells.boundary_lines.push_back(boundary_line);
-            }
+            add_boundary_line(mesh, vertices[0], vertices[1], id);
           else if (type != "pt")
-            {
-              CellData<2> cell(vertices.size());
-              // UCD runs round the quadrilateral; deal.II's order is
-              // lexicographic (0 1 3 2 round it).
-              if (vertices.size() == 4)
-                std::swap(vertices[2], vertices[3]);
-              cell.vertices    = vertices;
-              cell.material_id = id;
-              mesh.cells.push_back(cell);
-            }
+            add_cell(mesh, vertices, id);
         }
       AssertThrow(!mesh.cells.empty(),
                   ExcMessage("Mesh/File: '" + file +
@@ -1161,23 +1170,12 @@ namespace knee_contact
             fail("MaterialID " + text_of(id) + " of cell " + std::to_string(c) +
                  " is not in 0..254");
           if (types[c] == 3)
-            {
-              CellData<1> boundary_line;
-              boundary_line.vertices    = {vertices[0], vertices[1]};
-              boundary_line.boundary_id = static_cast<types::boundary_id>(id);
-              mesh.subcells.boundary_lines.push_back(boundary_line);
-            }
+            add_boundary_line(mesh,
+                              vertices[0],
+                              vertices[1],
+                              static_cast<types::boundary_id>(id));
           else if (types[c] != 1)
-            {
-              // VTK runs round the quadrilateral; deal.II's order is
-              // lexicographic.
-              if (vertices.size() == 4)
-                std::swap(vertices[2], vertices[3]);
-              CellData<2> cell(vertices.size());
-              cell.vertices    = vertices;
-              cell.material_id = static_cast<types::material_id>(id);
-              mesh.cells.push_back(cell);
-            }
+            add_cell(mesh, vertices, static_cast<types::material_id>(id));
         }
       if (mesh.cells.empty())
         fail("no triangles or quadrilaterals");

@@ -115,6 +115,13 @@ def main():
                           base.replace(mesh, "@WORK@/mesh" + ext),
                           ("mesh" + ext, data[: int(len(data) * fraction)])))
 
+    return run_cases(program, cases, "hostile variants")
+
+
+def run_cases(program, cases, what):
+    """Run the cases (name, scene text with @WORK@ for the work folder[,
+    (file name, bytes) written into it]) two at a time; print the exit
+    codes and the failures; 1 if any case failed, else 0."""
     def one(case):
         name, text = case[0], case[1]
         work = tempfile.mkdtemp(prefix="knee_fuzz_")
@@ -133,10 +140,9 @@ def main():
         print(f"exit code {code}: {outcomes.count(code)} variants")
     for f in failures:
         print("FAIL:", f)
-    print(f"{len(cases) - len(failures)} of {len(cases)} hostile variants "
+    print(f"{len(cases) - len(failures)} of {len(cases)} {what} "
           "handled (exit 0-3, one error line for exit 1, no crash or hang)")
     return 1 if failures else 0
-
 
 if __name__ == "__main__":
     sys.exit(main())

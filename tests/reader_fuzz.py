@@ -14,11 +14,9 @@ changed coordinate): then the run ends with 0, 2 or 3 and that is fine.
 
 Usage: reader_fuzz.py KNEE_CONTACT VARIANTS_PER_FILE
 """
-import concurrent.futures
 import os
 import random
 import re
-import shutil
 import subprocess
 import sys
 import tempfile
@@ -100,29 +98,7 @@ def main():
                 cases.append(("mesh%s: %s" % (suffix, what), scene,
                               ("mesh" + extension, damaged)))
 
-    def one(case):
-        name, text, (file_name, data) = case
-        work = tempfile.mkdtemp(prefix="knee_reader_fuzz_")
-        try:
-            with open(os.path.join(work, file_name), "wb") as f:
-                f.write(data)
-            return fuzz.run(program, name, text.replace("@WORK@", work),
-                            work)
-        finally:
-            shutil.rmtree(work, ignore_errors=True)
-
-    with concurrent.futures.ThreadPoolExecutor(2) as pool:
-        outcomes = list(pool.map(one, cases))
-    failures = [f for f in outcomes if isinstance(f, str)]
-    for code in (0, 1, 2, 3):
-        print("exit code %d: %d variants" % (code, outcomes.count(code)))
-    for f in failures:
-        print("FAIL:", f)
-    print("%d of %d damaged mesh files handled (exit 0-3, one error line "
-          "for exit 1, no crash or hang)" % (len(cases) - len(failures),
-                                             len(cases)))
-    return 1 if failures else 0
-
+    return fuzz.run_cases(program, cases, "damaged mesh files")
 
 if __name__ == "__main__":
     sys.exit(main())
