@@ -21,6 +21,8 @@ import subprocess
 import sys
 import tempfile
 
+# Import the sibling scripts without leaving __pycache__ in the source tree.
+sys.dont_write_bytecode = True
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import fuzz  # noqa: E402
 import mesh_formats  # noqa: E402
