@@ -48,11 +48,17 @@ namespace knee_contact
                       "negative lambda) while adding every penetrating pair; "
                       "false: stop with converged = false.");
     prm.declare_entry("Solver",
-                      "condensed",
-                      Patterns::Selection("condensed|step-41"),
-                      "condensed: factorise once per mesh with the contact "
-                      "unknowns last and run the loop on their Schur "
-                      "complement (about the cost of one linear solve); "
+                      "automatic",
+                      Patterns::Selection("automatic|condensed|sparse|step-41"),
+                      "automatic: estimate the time and memory of the "
+                      "condensed and sparse paths before allocating and take "
+                      "the cheaper that fits (the log and summary.json say "
+                      "which and why); condensed: factorise once per mesh "
+                      "with the contact unknowns last and run the loop on "
+                      "their dense Schur complement (cheapest where the "
+                      "contact unknowns are few); sparse: one CHOLMOD "
+                      "analysis per mesh, one numeric factorisation per "
+                      "active set (memory of the sparse factor only); "
                       "step-41: condense and factorise the whole system "
                       "with UMFPACK in every iteration (the first "
                       "version's path, kept for comparison).");
@@ -79,8 +85,11 @@ namespace knee_contact
     tolerance      = prm.get_double("Tolerance");
     safeguard      = prm.get_bool("Cycle safeguard");
     reference_solve = prm.get_bool("Reference solve");
-    solver          = prm.get("Solver") == "step-41" ? LinearSolver::step41
-                                                     : LinearSolver::condensed;
+    const std::string path = prm.get("Solver");
+    solver                 = path == "step-41"   ? LinearSolver::step41 :
+                             path == "sparse"    ? LinearSolver::sparse :
+                             path == "condensed" ? LinearSolver::condensed :
+                                                   LinearSolver::automatic;
     AssertThrow(c > 0, ExcMessage("Contact/Active set constant must be > 0"));
     prm.leave_subsection();
   }

@@ -1,12 +1,10 @@
 #include <knee_contact/active_set.h>
 #include <knee_contact/contact_system.h>
+#include <knee_contact/sparse_cholesky.h>
 
 #include <deal.II/base/timer.h>
 
 #include <deal.II/lac/lapack_templates.h>
-
-#include <cholmod.h>
-#include <metis.h>
 
 #include <algorithm>
 #include <cmath>
@@ -18,330 +16,10 @@
 
 namespace knee_contact
 {
+  using sparse_cholesky::SparseCholesky;
+
   namespace
   {
-    /**
-     * C under the Gamma_u/Gamma_o/hanging lines, C0^T C C0 on the free dofs
-     * and a decoupled diagonal on the constrained ones, as
-     * AffineConstraints::condense() makes it; only its nonzero entries are
-     * kept (the pattern of the matrix also holds the couplings of every
-     * active set, which would only add fill here).
-     */
-    struct CondensedMatrix
-    {
-      std::vector<std::size_t>             row_start; // CSR over all dofs
-      std::vector<types::global_dof_index> column;
-      std::vector<double>                  value;
-    };
-
-    CondensedMatrix
-    condense(const SparseMatrix<double>      &matrix,
-             const AffineConstraints<double> &constraints)
-    {
-      SparseMatrix<double> copy(matrix.get_sparsity_pattern());
-      copy.copy_from(matrix);
-      constraints.condense(copy);
-      CondensedMatrix result;
-      const auto      n = matrix.m();
-      result.row_start.reserve(n + 1);
-      result.row_start.push_back(0);
-      for (types::global_dof_index i = 0; i < n; ++i)
-        {
-          for (auto it = copy.begin(i); it != copy.end(i); ++it)
-            if (it->value() != 0 || it->column() == i)
-              {
-                result.column.push_back(it->column());
-                result.value.push_back(it->value());
-              }
-          result.row_start.push_back(result.column.size());
-        }
-      return result;
-    }
-
-
-
-    /**
-     * C0^T (d - C g) on the free dofs, zero on the constrained ones: the
-     * right hand side of the condensed system for inhomogeneous lines
-     * x_i = sum_j c_ij x_j + g_i. (AffineConstraints condenses a vector
-     * only for homogeneous lines.)
-     */
-    Vector<double>
-    condense(const SparseMatrix<double>      &matrix,
-             const Vector<double>            &rhs,
-             const AffineConstraints<double> &constraints)
-    {
-      Vector<double> g(rhs.size());
-      for (const auto &line : constraints.get_lines())
-        g(line.index) = line.inhomogeneity;
-      Vector<double> b(rhs.size());
-      matrix.residual(b, g, rhs);
-      for (const auto &line : constraints.get_lines())
-        for (const auto &[j, c] : line.entries)
-          b(j) += c * b(line.index);
-      for (const auto &line : constraints.get_lines())
-        b(line.index) = 0;
-      return b;
-    }
-
-
-
-    /**
-     * A fill-reducing ordering: METIS nested dissection of the graph of
-     * mesh vertices (dofs with identical rows, the components of a vertex,
-     * are ordered together, which makes METIS several times faster than on
-     * the dofs), with the dofs in @p last (in their order) at the end.
-     * Returns perm with perm[new position] = dof.
-     */
-    std::vector<int>
-    fill_reducing_ordering(const CondensedMatrix                      &a,
-                           const std::vector<types::global_dof_index> &last)
-    {
-      const std::size_t n = a.row_start.size() - 1;
-      std::vector<bool> is_last(n, false);
-      for (const auto d : last)
-        is_last[d] = true;
-      // Dofs with identical rows (sorted: deal.II stores the diagonal
-      // first) belong to one vertex.
-      std::vector<int>                     node_of(n, -1);
-      std::vector<std::vector<int>>        dofs_of_node;
-      std::vector<types::global_dof_index> row_i, row_j;
-      const auto sorted = [&](const std::size_t i, auto &row) {
-        row.assign(a.column.begin() + a.row_start[i],
-                   a.column.begin() + a.row_start[i + 1]);
-        std::sort(row.begin(), row.end());
-      };
-      for (std::size_t i = 0; i < n; ++i)
-        if (!is_last[i])
-          {
-            if (i > 0 && !is_last[i - 1] && node_of[i - 1] >= 0 &&
-                dofs_of_node[node_of[i - 1]].size() < 3)
-              {
-                sorted(i - 1, row_j);
-                sorted(i, row_i);
-                if (row_i == row_j)
-                  {
-                    node_of[i] = node_of[i - 1];
-                    dofs_of_node[node_of[i]].push_back(i);
-                    continue;
-                  }
-              }
-            node_of[i] = dofs_of_node.size();
-            dofs_of_node.push_back({static_cast<int>(i)});
-          }
-
-      const idx_t        n_nodes = dofs_of_node.size();
-      std::vector<idx_t> xadj(n_nodes + 1, 0), adjncy;
-      std::vector<idx_t> neighbours;
-      for (idx_t v = 0; v < n_nodes; ++v)
-        {
-          neighbours.clear();
-          for (const int i : dofs_of_node[v])
-            for (std::size_t k = a.row_start[i]; k < a.row_start[i + 1]; ++k)
-              {
-                const auto j = a.column[k];
-                if (!is_last[j] && node_of[j] != v)
-                  neighbours.push_back(node_of[j]);
-              }
-          std::sort(neighbours.begin(), neighbours.end());
-          neighbours.erase(std::unique(neighbours.begin(), neighbours.end()),
-                           neighbours.end());
-          adjncy.insert(adjncy.end(), neighbours.begin(), neighbours.end());
-          xadj[v + 1] = adjncy.size();
-        }
-      std::vector<idx_t> perm(n_nodes), iperm(n_nodes);
-      if (n_nodes > 0)
-        {
-          idx_t options[METIS_NOPTIONS];
-          METIS_SetDefaultOptions(options);
-          options[METIS_OPTION_NUMBERING] = 0;
-          idx_t      nv                   = n_nodes;
-          const auto status =
-            METIS_NodeND(&nv,
-                         xadj.data(),
-                         adjncy.empty() ? nullptr : adjncy.data(),
-                         nullptr,
-                         options,
-                         perm.data(),
-                         iperm.data());
-          if (status == METIS_ERROR_MEMORY)
-            throw std::bad_alloc();
-          if (status != METIS_OK)
-            throw std::runtime_error("METIS failed to order the stiffness "
-                                     "matrix");
-        }
-      std::vector<int> order;
-      order.reserve(n);
-      for (const idx_t v : perm)
-        for (const int i : dofs_of_node[v])
-          order.push_back(i);
-      for (const auto d : last)
-        order.push_back(d);
-      return order;
-    }
-
-
-
-    /**
-     * CHOLMOD's supernodal LL^T of a symmetric positive definite matrix in
-     * a given order.
-     */
-    class SparseCholesky
-    {
-    public:
-      SparseCholesky()
-      {
-        cholmod_start(&common);
-        common.print                      = 0;
-        common.error_handler              = nullptr;
-        common.supernodal                 = CHOLMOD_SUPERNODAL;
-        common.nmethods                   = 1;
-        common.method[0].ordering         = CHOLMOD_GIVEN;
-        common.postorder                  = false;
-        common.quick_return_if_not_posdef = true;
-      }
-
-      ~SparseCholesky()
-      {
-        if (factor != nullptr)
-          cholmod_free_factor(&factor, &common);
-        cholmod_finish(&common);
-      }
-
-      SparseCholesky(const SparseCholesky &) = delete;
-      SparseCholesky &
-      operator=(const SparseCholesky &) = delete;
-
-      /**
-       * Factorise @p a plus @p shift on the diagonal of the last
-       * @p n_shifted dofs of @p order; false if not positive definite.
-       */
-      bool
-      factorise(const CondensedMatrix  &a,
-                const std::vector<int> &order,
-                const std::size_t       n_shifted,
-                const double            shift)
-      {
-        const std::size_t n = a.row_start.size() - 1;
-        std::vector<bool> shifted(n, false);
-        for (std::size_t k = order.size() - n_shifted; k < order.size(); ++k)
-          shifted[order[k]] = true;
-        // The upper triangle by columns is the lower one of C by rows.
-        std::size_t nnz = 0;
-        for (std::size_t i = 0; i < n; ++i)
-          for (std::size_t k = a.row_start[i]; k < a.row_start[i + 1]; ++k)
-            nnz += a.column[k] <= i;
-        cholmod_sparse *matrix = cholmod_allocate_sparse(
-          n, n, nnz, false, true, 1, CHOLMOD_REAL, &common);
-        check("allocate");
-        auto *p = static_cast<int *>(matrix->p);
-        auto *r = static_cast<int *>(matrix->i);
-        auto *x = static_cast<double *>(matrix->x);
-        nnz     = 0;
-        for (std::size_t i = 0; i < n; ++i)
-          {
-            p[i] = nnz;
-            for (std::size_t k = a.row_start[i]; k < a.row_start[i + 1]; ++k)
-              if (a.column[k] <= i)
-                {
-                  r[nnz] = a.column[k];
-                  x[nnz] =
-                    a.value[k] + (a.column[k] == i && shifted[i] ? shift : 0.);
-                  ++nnz;
-                }
-          }
-        p[n] = nnz;
-
-        std::vector<int> perm(order.begin(), order.end());
-        factor = cholmod_analyze_p(matrix, perm.data(), nullptr, 0, &common);
-        check("analyse");
-        cholmod_factorize(matrix, factor, &common);
-        cholmod_free_sparse(&matrix, &common);
-        if (common.status == CHOLMOD_NOT_POSDEF)
-          return false;
-        check("factorise");
-        return true;
-      }
-
-      /**
-       * The trailing k x k block of L (positions n-k..n-1), dense,
-       * column-major, lower triangle.
-       */
-      std::vector<double>
-      trailing_block(const std::size_t k) const
-      {
-        const std::size_t   n = factor->n;
-        std::vector<double> block(k * k, 0.);
-        const auto         *super = static_cast<const int *>(factor->super);
-        const auto         *pi    = static_cast<const int *>(factor->pi);
-        const auto         *px    = static_cast<const int *>(factor->px);
-        const auto         *s     = static_cast<const int *>(factor->s);
-        const auto         *x     = static_cast<const double *>(factor->x);
-        for (std::size_t sn = 0; sn < factor->nsuper; ++sn)
-          {
-            const std::size_t first = super[sn], end = super[sn + 1];
-            if (end <= n - k)
-              continue;
-            const std::size_t n_rows = pi[sn + 1] - pi[sn];
-            for (std::size_t col = std::max(first, n - k); col < end; ++col)
-              for (std::size_t r = 0; r < n_rows; ++r)
-                {
-                  const std::size_t row = s[pi[sn] + r];
-                  if (row >= col)
-                    block[(col - (n - k)) * k + (row - (n - k))] =
-                      x[px[sn] + r + (col - first) * n_rows];
-                }
-          }
-        return block;
-      }
-
-      /** Memory of the factor's values and row indices [MB]. */
-      double
-      memory_MB() const
-      {
-        if (factor == nullptr)
-          return 0;
-        return (factor->xsize * sizeof(double) + factor->ssize * sizeof(int)) /
-               1048576.;
-      }
-
-      /** x = solve(system, b) for CHOLMOD_P, _L, _Lt, _Pt, _A. */
-      void
-      solve(const int system, std::vector<double> &b)
-      {
-        cholmod_dense rhs;
-        rhs.nrow         = b.size();
-        rhs.ncol         = 1;
-        rhs.nzmax        = b.size();
-        rhs.d            = b.size();
-        rhs.x            = b.data();
-        rhs.z            = nullptr;
-        rhs.xtype        = CHOLMOD_REAL;
-        rhs.dtype        = CHOLMOD_DOUBLE;
-        cholmod_dense *x = cholmod_solve(system, factor, &rhs, &common);
-        check("solve");
-        std::copy_n(static_cast<const double *>(x->x), b.size(), b.begin());
-        cholmod_free_dense(&x, &common);
-      }
-
-    private:
-      void
-      check(const char *what)
-      {
-        if (common.status == CHOLMOD_OUT_OF_MEMORY)
-          throw std::bad_alloc();
-        if (common.status < CHOLMOD_OK)
-          throw std::runtime_error(std::string("CHOLMOD failed to ") + what +
-                                   " (status " + std::to_string(common.status) +
-                                   ")");
-      }
-
-      cholmod_common  common;
-      cholmod_factor *factor = nullptr;
-    };
-
-
-
     /** C = A A^T - shift I for a dense lower-triangular A (k x k). */
     std::vector<double>
     product_with_transpose(const std::vector<double> &a,
@@ -425,7 +103,8 @@ namespace knee_contact
   CondensedContactSystem::CondensedContactSystem(
     const SparseMatrix<double>      &matrix,
     const AffineConstraints<double> &base,
-    const std::vector<ContactPair>  &pairs)
+    const std::vector<ContactPair>  &pairs,
+    const std::vector<int>          &order)
     : implementation(std::make_unique<Implementation>(matrix, base, pairs))
   {
     Implementation &d = *implementation;
@@ -446,8 +125,17 @@ namespace knee_contact
           d.rows[p].emplace_back(d.local_of.at(dof), a);
 
     Timer                 clock;
-    const CondensedMatrix a = condense(matrix, base);
-    d.order                 = fill_reducing_ordering(a, d.dofs);
+    const auto a = sparse_cholesky::condense(matrix, base);
+    if (order.empty())
+      d.order = sparse_cholesky::fill_reducing_ordering(a, d.dofs);
+    else
+      {
+        d.order.reserve(order.size());
+        for (const int i : order)
+          if (d.local_of.find(i) == d.local_of.end())
+            d.order.push_back(i);
+        d.order.insert(d.order.end(), d.dofs.begin(), d.dofs.end());
+      }
     d.timings.ordering      = clock.wall_time();
 
     clock.restart();
@@ -458,8 +146,15 @@ namespace knee_contact
       for (std::size_t k = a.row_start[i]; k < a.row_start[i + 1]; ++k)
         if (a.column[k] == i)
           d.shift = std::max(d.shift, std::abs(a.value[k]));
-    if (!d.cholesky.factorise(a, d.order, d.dofs.size(), d.shift))
+    // Postordering merges supernodes (2-3x faster factorisations) and
+    // keeps a dense trailing block last, as the Schur complement needs;
+    // checked, and analysed without it where it does not.
+    d.cholesky.analyse(a, d.order, true);
+    if (!d.cholesky.keeps_last(d.dofs.size()))
+      d.cholesky.analyse(a, d.order, false);
+    if (!d.cholesky.factorise(a, d.dofs.size(), d.shift))
       AssertThrow(false, ExcNotPositiveDefinite());
+    d.cholesky.release_matrix();
     d.timings.factorisation = clock.wall_time();
 
     clock.restart();
@@ -623,6 +318,25 @@ namespace knee_contact
 
 
 
+  std::map<std::string, double>
+  CondensedContactSystem::statistics() const
+  {
+    const Timings &t                 = implementation->timings;
+    const auto [factor_MB, dense_MB] = memory_MB();
+    return {{"contact_unknowns", n_contact_unknowns()},
+            {"ordering", t.ordering},
+            {"factorisation", t.factorisation},
+            {"schur_complement", t.schur},
+            {"loop_setup", t.loop_setup},
+            {"factor_memory_MB", factor_MB},
+            {"dense_memory_MB", dense_MB},
+            {"condensation", t.condensation},
+            {"active_set_loop", t.dense},
+            {"expansion", t.expansion}};
+  }
+
+
+
   const CondensedContactSystem::Timings &
   CondensedContactSystem::timings() const
   {
@@ -636,7 +350,7 @@ namespace knee_contact
   {
     Implementation &d = *implementation;
     Timer           clock;
-    const auto      b = condense(d.matrix, rhs, d.base);
+    const auto b = sparse_cholesky::condense(d.matrix, rhs, d.base);
     // y = L^-1 P b; with L = [L_ii 0; L_ci L_cc], f = b_c - C_ci C_ii^-1 b_i
     // = L_cc y_c.
     d.forward.assign(b.begin(), b.end());
@@ -846,11 +560,12 @@ namespace knee_contact
     AffineConstraints<double> constraints;
     ActiveSetSolver::make_constraints(base, pairs, active, constraints);
     Timer                 clock;
-    const CondensedMatrix a     = condense(matrix, constraints);
-    const auto            b     = condense(matrix, rhs, constraints);
-    const auto            order = fill_reducing_ordering(a, {});
-    SparseCholesky        cholesky;
-    AssertThrow(cholesky.factorise(a, order, 0, 0.),
+    const auto a     = sparse_cholesky::condense(matrix, constraints);
+    const auto b     = sparse_cholesky::condense(matrix, rhs, constraints);
+    const auto order = sparse_cholesky::fill_reducing_ordering(a, {});
+    SparseCholesky cholesky;
+    cholesky.analyse(a, order, true);
+    AssertThrow(cholesky.factorise(a),
                 ExcMessage("the reference system is not positive definite"));
     std::vector<double> z(b.begin(), b.end());
     cholesky.solve(CHOLMOD_A, z);

@@ -322,34 +322,15 @@ namespace knee_contact
           {
             solver_figures.clear();
             contact_system.reset();
-            condensed_system = nullptr;
-            if (active_set_solver.linear_solver() ==
-                ActiveSetSolver::LinearSolver::condensed)
-              try
-                {
-                  auto made =
-                    std::make_unique<CondensedContactSystem>(system_matrix,
-                                                             constraints,
-                                                             contact_pairs);
-                  condensed_system = made.get();
-                  contact_system   = std::move(made);
-                }
-              catch (const CondensedContactSystem::ExcNotPositiveDefinite &)
-                {
-                  // A body held by fewer contact unknowns than its rigid
-                  // motions (e.g. a single contact vertex) leaves C_ii
-                  // singular; the full path constrains before factorising.
-                  loop_log << "   the interior of a body is not held "
-                              "without its contact rows: using the step-41 "
-                              "solver"
-                           << std::endl;
-                }
-            if (!contact_system)
-              contact_system =
-                std::make_unique<FullContactSystem>(system_matrix,
-                                                    constraints,
-                                                    contact_pairs);
-            solver_name = condensed_system ? "condensed" : "step-41";
+            contact_system =
+              make_contact_system(active_set_solver.linear_solver(),
+                                  system_matrix,
+                                  constraints,
+                                  contact_pairs,
+                                  !guess.empty(),
+                                  output_writer.test_mode() ? quiet : loop_log,
+                                  solver_name,
+                                  solver_figures);
           }
         contact_system->set_rhs(system_rhs);
         contact_solution = active_set_solver.solve(*contact_system,
@@ -361,22 +342,8 @@ namespace knee_contact
                                                    loop_log);
         contact_system->solution(displacement);
         solver_figures["contact_solve"] = clock.wall_time();
-        if (condensed_system)
-          {
-            const auto &t = condensed_system->timings();
-            solver_figures["contact_unknowns"] =
-              condensed_system->n_contact_unknowns();
-            solver_figures["ordering"]         = t.ordering;
-            solver_figures["factorisation"]    = t.factorisation;
-            solver_figures["schur_complement"] = t.schur;
-            solver_figures["loop_setup"]       = t.loop_setup;
-            const auto [factor_MB, dense_MB]   = condensed_system->memory_MB();
-            solver_figures["factor_memory_MB"] = factor_MB;
-            solver_figures["dense_memory_MB"]  = dense_MB;
-            solver_figures["condensation"]     = t.condensation;
-            solver_figures["active_set_loop"]  = t.dense;
-            solver_figures["expansion"]        = t.expansion;
-          }
+        for (const auto &[name, value] : contact_system->statistics())
+          solver_figures[name] = value;
         if (new_matrix && active_set_solver.measure_reference())
           {
             Vector<double> x;
@@ -392,7 +359,7 @@ namespace knee_contact
               x.linfty_norm() / std::max(displacement.linfty_norm(), 1e-300);
           }
       }
-    catch (const CondensedContactSystem::ExcNotPositiveDefinite &)
+    catch (const ContactSystem::ExcNotPositiveDefinite &)
       {
         AssertThrow(false,
                     ExcMessage("the stiffness matrix is singular "

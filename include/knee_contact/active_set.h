@@ -63,11 +63,7 @@ namespace knee_contact
     /**
      * How the linear systems of the loop are solved (see ContactSystem).
      */
-    enum class LinearSolver
-    {
-      condensed,
-      step41
-    };
+    using LinearSolver = SolverPath;
 
     LinearSolver
     linear_solver() const
@@ -144,7 +140,7 @@ namespace knee_contact
     double       c               = 0;
     double       tolerance       = 1e-10;
     bool         safeguard       = true;
-    LinearSolver solver          = LinearSolver::condensed;
+    LinearSolver solver          = LinearSolver::automatic;
     bool         reference_solve = false;
   };
 } // namespace knee_contact

@@ -7,7 +7,9 @@
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/vector.h>
 
+#include <map>
 #include <memory>
+#include <ostream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -31,6 +33,10 @@ namespace knee_contact
   {
   public:
     virtual ~ContactSystem() = default;
+
+    DeclExceptionMsg(ExcNotPositiveDefinite,
+                     "the stiffness matrix with the contact unknowns held "
+                     "is singular");
 
     /**
      * A load case: the load vector d of the following solves (the matrix and
@@ -62,6 +68,16 @@ namespace knee_contact
      */
     virtual void
     solution(Vector<double> &x) = 0;
+
+    /**
+     * The path's own figures for summary.json and the benchmark (times of
+     * its phases [s], sizes, memory [MB]), by name.
+     */
+    virtual std::map<std::string, double>
+    statistics() const
+    {
+      return {};
+    }
   };
 
 
@@ -134,15 +150,15 @@ namespace knee_contact
      * Order, analyse and factorise C under @p base (closed); throws
      * ExcNotPositiveDefinite if C_ii is singular (a body that neither the
      * boundary conditions nor its contact unknowns can hold).
+     * @p order: a fill-reducing ordering of all dofs computed by the caller
+     * (the contact unknowns are moved to its end); empty: METIS on the
+     * interior here.
      */
     CondensedContactSystem(const SparseMatrix<double>      &matrix,
                            const AffineConstraints<double> &base,
-                           const std::vector<ContactPair>  &pairs);
+                           const std::vector<ContactPair>  &pairs,
+                           const std::vector<int>          &order = {});
     ~CondensedContactSystem() override;
-
-    DeclExceptionMsg(ExcNotPositiveDefinite,
-                     "the stiffness matrix with the contact unknowns held "
-                     "is singular");
 
     /**
      * A load case: condense d onto the contact unknowns (one forward
@@ -189,10 +205,108 @@ namespace knee_contact
     std::pair<double, double>
     memory_MB() const;
 
+    std::map<std::string, double>
+    statistics() const override;
+
   private:
     class Implementation;
     std::unique_ptr<Implementation> implementation;
   };
+
+
+
+  /**
+   * The sparse path: step-41's iteration (condense the active rows into C,
+   * factorise, solve), made as cheap as a sparse factor allows. The
+   * matrix's pattern holds the condensed system of every active set
+   * (ActiveSetSolver::make_sparsity_pattern), so one METIS ordering and one
+   * CHOLMOD symbolic analysis serve every iteration and load case of a
+   * mesh; an iteration costs one numeric (supernodal) factorisation, and a
+   * solve with the active set of the previous one (a further load case, a
+   * repeated set) costs two triangular solves. Memory is that of the
+   * sparse factor: no dense interface matrices, so it scales where the
+   * condensed path does not (long contact zones, adaptive meshes).
+   */
+  class SparseContactSystem : public ContactSystem
+  {
+  public:
+    /**
+     * Order and analyse (no factorisation yet). @p order: a METIS ordering
+     * of the pattern computed by the caller (empty: compute it here).
+     */
+    SparseContactSystem(const SparseMatrix<double>      &matrix,
+                        const AffineConstraints<double> &base,
+                        const std::vector<ContactPair>  &pairs,
+                        std::vector<int>                 order = {});
+    ~SparseContactSystem() override;
+
+    void
+    set_rhs(const Vector<double> &rhs) override;
+
+    void
+    solve(const std::vector<bool> &active,
+          std::vector<double>     &excess,
+          std::vector<double>     &lambda) override;
+
+    double
+    displacement_scale() const override;
+
+    void
+    solution(Vector<double> &x) override;
+
+    std::map<std::string, double>
+    statistics() const override;
+
+    /** Entries of the factor and flops of one factorisation. */
+    double
+    nnz_factor() const;
+    double
+    flops() const;
+
+  private:
+    class Implementation;
+    std::unique_ptr<Implementation> implementation;
+  };
+
+
+
+  /**
+   * How the active-set loop's linear algebra is done (Contact/Solver).
+   */
+  enum class SolverPath
+  {
+    automatic,
+    condensed,
+    sparse,
+    step41
+  };
+
+  /** "automatic", "condensed", "sparse", "step-41". */
+  std::string
+  solver_path_name(const SolverPath path);
+
+  /**
+   * The one factory of the solver seam. For SolverPath::automatic it
+   * estimates, before allocating, the time (flops) and peak memory of the
+   * condensed path (its dense interface arrays, k^3 and P^3 work) and of
+   * the sparse path (factor size and flops from CHOLMOD's symbolic
+   * analysis, times the expected iterations) and takes the cheaper that
+   * fits in the memory available to the process (MemAvailable, the cgroup
+   * limit, ulimit -v); a requested path that does not fit is switched, and
+   * if none fits the run is refused in one line naming the estimate and
+   * the limit. @p warm_start: the loop starts from a guess (a refined
+   * mesh, a further load case), so fewer iterations are expected. @p log
+   * gets one line saying which path and why; @p name receives the path.
+   */
+  std::unique_ptr<ContactSystem>
+  make_contact_system(const SolverPath                 requested,
+                      const SparseMatrix<double>      &matrix,
+                      const AffineConstraints<double> &base,
+                      const std::vector<ContactPair>  &pairs,
+                      const bool                       warm_start,
+                      std::ostream                    &log,
+                      std::string                     &name,
+                      std::map<std::string, double>   &figures);
 
 
 

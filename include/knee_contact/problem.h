@@ -236,7 +236,6 @@ namespace knee_contact
     ContactSolution           contact_solution;
     /** The last cycle's factorised system, kept for further load cases. */
     std::unique_ptr<ContactSystem> contact_system;
-    CondensedContactSystem        *condensed_system = nullptr;
     /**
      * The last solve's solver figures for summary.json: phase times [s],
      * number of contact unknowns, reference solve (see ActiveSetSolver).
