@@ -218,6 +218,8 @@ namespace knee_contact
     figures["estimated_sparse_Gflop"]     = sparse_flops / 1e9;
     figures["estimated_condensed_Gflop"]  = condensed_flops / 1e9;
     figures["available_MB"]               = available / 1048576.;
+    figures["process_virtual_MB"] =
+      read_field("/proc/self/status", "VmSize:", 1024.) / 1048576.;
     figures["contact_unknowns"]           = k;
 
     SolverPath  path = requested;
@@ -250,6 +252,10 @@ namespace knee_contact
       }
     else
       reason = "as Contact/Solver says";
+    // Neither fits: name the smaller of the two needs.
+    if (!fits(condensed_bytes) && !fits(sparse_bytes))
+      path = condensed_bytes < sparse_bytes ? SolverPath::condensed :
+                                              SolverPath::sparse;
     const double needed =
       path == SolverPath::condensed ? condensed_bytes : sparse_bytes;
     AssertThrow(fits(needed),
