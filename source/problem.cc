@@ -286,7 +286,9 @@ namespace knee_contact
         record.n_cells      = triangulation.n_active_cells();
         record.n_dofs       = dof_handler.n_dofs();
         record.n_pairs      = contact_pairs.size();
-        record.n_iterations = contact_solution.n_iterations;
+        record.n_iterations   = contact_solution.n_iterations;
+        record.solver         = solver_name;
+        record.solver_figures = solver_figures;
         record.energy       = results.energy;
         for (const auto &i : results.interfaces)
           record.peak_pressure = std::max(record.peak_pressure, i.max_pressure);
@@ -445,7 +447,10 @@ namespace knee_contact
                                       displacement,
                                       contact_solution,
                                       results);
-      if (sequences.size() > 1)
+      std::size_t n_records = 0;
+      for (const auto &records : sequences)
+        n_records += records.size();
+      if (n_records > 1)
         output_writer.write_file("study.csv", [&](std::ostream &out) {
           std::vector<CycleRecord> all;
           for (const auto &records : sequences)

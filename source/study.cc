@@ -78,7 +78,15 @@ namespace knee_contact
     const auto &phases = records.front().wall_time;
     for (const auto &phase : phases)
       out << ",time_" << phase.first;
-    out << ",time_total,peak_memory_MB\n" << std::setprecision(10);
+    const char *solver_columns[] = {"contact_solve",
+                                    "reference_solve",
+                                    "contact_unknowns",
+                                    "factor_memory_MB",
+                                    "dense_memory_MB"};
+    out << ",time_total,peak_memory_MB,solver";
+    for (const char *column : solver_columns)
+      out << ',' << column;
+    out << '\n' << std::setprecision(10);
     for (const CycleRecord &r : records)
       {
         out << r.strategy << ',' << r.cycle << ',' << r.n_cells << ','
@@ -91,7 +99,13 @@ namespace knee_contact
             const auto it = r.wall_time.find(phase.first);
             out << ',' << (it == r.wall_time.end() ? 0. : it->second);
           }
-        out << ',' << r.total_time << ',' << r.peak_memory << '\n';
+        out << ',' << r.total_time << ',' << r.peak_memory << ',' << r.solver;
+        for (const char *column : solver_columns)
+          {
+            const auto it = r.solver_figures.find(column);
+            out << ',' << (it == r.solver_figures.end() ? 0. : it->second);
+          }
+        out << '\n';
       }
   }
 } // namespace knee_contact

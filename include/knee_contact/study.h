@@ -28,6 +28,9 @@ namespace knee_contact
     double                        peak_pressure = 0;
     double                        energy        = 0;
     Errors                        errors;
+    /** The contact solver's path and figures (summary.json's "solver"). */
+    std::string                   solver;
+    std::map<std::string, double> solver_figures;
   };
 
   /**
@@ -41,7 +44,8 @@ namespace knee_contact
                           std::ostream                   &out);
 
   /**
-   * All records as CSV, one row per cycle.
+   * All records as CSV, one row per cycle, with the contact solver's path,
+   * contact solve, reference solve (if measured) and contact unknowns.
    */
   void
   write_study_csv(const std::vector<CycleRecord> &records, std::ostream &out);
