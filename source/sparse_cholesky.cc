@@ -281,14 +281,11 @@ namespace knee_contact
 
 
 
-    bool
-    SparseCholesky::keeps_last(const std::size_t k) const
+    std::vector<int>
+    SparseCholesky::final_last(const std::size_t k) const
     {
       const auto *perm = static_cast<const int *>(factor->Perm);
-      for (std::size_t i = order.size() - k; i < order.size(); ++i)
-        if (perm[i] != order[i])
-          return false;
-      return true;
+      return std::vector<int>(perm + factor->n - k, perm + factor->n);
     }
 
 

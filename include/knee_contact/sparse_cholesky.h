@@ -124,11 +124,11 @@ namespace knee_contact
       release_matrix();
 
       /**
-       * Whether the factor's final order (after postordering) ends with
-       * the last @p k dofs of the given order, in that order.
+       * The last @p k dofs of the factor's final order (after
+       * postordering), position by position.
        */
-      bool
-      keeps_last(const std::size_t k) const;
+      std::vector<int>
+      final_last(const std::size_t k) const;
 
       /** Entries of L and flops of one factorisation, from the analysis. */
       double
