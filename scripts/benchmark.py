@@ -219,6 +219,8 @@ def median_run(program, scene, changes, work, repeat):
                           for r in runs),
         "memory": median(lambda r: r["solver"]["peak_memory_MB"]),
     }
+    figures["choice"] = median(lambda r: r["solver"].get("choice_ordering", 0)
+                               + r["solver"].get("choice_analysis", 0))
     for phase in ["ordering", "factorisation", "schur_complement",
                   "loop_setup", "active_set_loop", "expansion",
                   "factor_memory_MB", "dense_memory_MB"]:
@@ -284,20 +286,21 @@ def main():
 
         print("\n%s (%s), median of %d run(s)" % (name, scene, args.repeat))
         header = ("dofs", "pairs", "k", "path", "it", "one solve", "contact",
-                  "ratio", "step-41", "speed-up", "order", "factor", "Schur",
+                  "ratio", "step-41", "speed-up", "choice", "order", "factor",
+                  "Schur",
                   "loop set-up", "loop", "expand", "setup", "assembly",
                   "output", "kB/dof", "factor kB/dof", "dense kB/dof")
         print("| " + " | ".join(header) + " |")
         print("|" + "---|" * len(header))
         for r in rows:
             print("| %d | %d | %d | %s | %d | %.3g | %.3g | %.2f | %.3g | %.1f | "
-                  "%.3g | %.3g | %.3g | %.3g | %.3g | %.3g | %.3g | %.3g | "
+                  "%.3g | %.3g | %.3g | %.3g | %.3g | %.3g | %.3g | %.3g | %.3g | "
                   "%.3g | %.2f | %.2f | %.2f |" % (
                       r["dofs"], r["pairs"], r["k"], r["path"],
                       r["iterations"],
                       r["reference"], r["contact"],
                       r["contact"] / r["reference"], r["step41"],
-                      r["step41"] / r["contact"], r["ordering"],
+                      r["step41"] / r["contact"], r["choice"], r["ordering"],
                       r["factorisation"], r["schur_complement"],
                       r["loop_setup"], r["active_set_loop"], r["expansion"],
                       r["setup"], r["assembly"], r["output"],

@@ -43,6 +43,24 @@ namespace knee_contact
 
 
 
+    CsrMatrix
+    pattern_of(const SparsityPattern &pattern)
+    {
+      CsrMatrix result;
+      result.row_start.reserve(pattern.n_rows() + 1);
+      result.row_start.push_back(0);
+      result.column.reserve(pattern.n_nonzero_elements());
+      for (types::global_dof_index i = 0; i < pattern.n_rows(); ++i)
+        {
+          for (auto it = pattern.begin(i); it != pattern.end(i); ++it)
+            result.column.push_back(it->column());
+          result.row_start.push_back(result.column.size());
+        }
+      return result;
+    }
+
+
+
     Vector<double>
     condense(const SparseMatrix<double>      &matrix,
              const Vector<double>            &rhs,

@@ -102,7 +102,6 @@ namespace knee_contact
       : matrix(matrix)
       , base(base)
       , pairs(pairs)
-      , condensed(matrix.get_sparsity_pattern())
     {}
 
     const SparseMatrix<double>      &matrix;
@@ -163,6 +162,8 @@ namespace knee_contact
     // each solved for its eliminated dof (as in step-41), condensed into C
     // on the one pattern of every active set.
     ActiveSetSolver::make_constraints(base, pairs, active, constraints);
+    if (!has_factor && n_factorisations == 0)
+      condensed.reinit(matrix.get_sparsity_pattern());
     condensed.copy_from(matrix);
     constraints.condense(condensed);
     has_factor = false;
@@ -244,10 +245,9 @@ namespace knee_contact
     : implementation(std::make_unique<Implementation>(matrix, base, pairs))
   {
     Implementation &d = *implementation;
-    // The pattern of every active set: each entry of the matrix's pattern,
-    // values irrelevant for ordering and analysis.
-    const auto pattern = sparse_cholesky::condense(
-      matrix, AffineConstraints<double>(), /*keep_pattern=*/true);
+    // The pattern of every active set: each entry of the matrix's pattern.
+    const auto pattern =
+      sparse_cholesky::pattern_of(matrix.get_sparsity_pattern());
     Timer clock;
     if (order.empty())
       order = sparse_cholesky::fill_reducing_ordering(pattern, {});
@@ -289,7 +289,7 @@ namespace knee_contact
     // kept while A0 stays), x = x0 + (D - W) s - V mu, where
     //   [D^T C (D - W)   D^T B_N^T - D^T C V] [s ]   [D^T (f - C x0)]
     //   [B_N (D - W)     -B_N V             ] [mu] = [g_N - B_N x0  ].
-    // It pays while the solves made on one factor cost less than a
+    // It pays while an iteration's new solves cost less than a
     // factorisation; otherwise A becomes the new A0.
     std::vector<unsigned int> changed;
     unsigned int              n_new = 0;
@@ -304,11 +304,15 @@ namespace knee_contact
     // 16 nnz(L) flops of the factorisation's rate (measured at 4.5e5 dofs:
     // 0.14 s against 3.5 s for a factorisation of 15.6 Gflop with
     // nnz(L) = 4e7); an update iteration one more solve (the refinement).
+    // The corrections already made are paid for; the new ones are weighed
+    // against a factorisation, and their vectors (n doubles each) may take
+    // at most the factor's memory.
     const double correction_flops = 16 * d.cholesky.nnz_factor();
+    const double vector_MB        = 8. * d.matrix.m() / 1048576.;
     if (!d.has_factor ||
-        (d.corrections.size() + n_new + d.n_updates_on_factor + 1) *
-            correction_flops >
-          d.cholesky.flops() ||
+        (n_new + 1) * correction_flops > d.cholesky.flops() ||
+        (d.corrections.size() + n_new) * vector_MB >
+          std::max(d.cholesky.memory_MB(), 8 * vector_MB) ||
         changed.size() > 500)
       {
         d.factorise(active);

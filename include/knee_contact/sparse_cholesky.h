@@ -3,6 +3,7 @@
 
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/sparse_matrix.h>
+#include <deal.II/lac/sparsity_pattern.h>
 #include <deal.II/lac/vector.h>
 
 #include <cholmod.h>
@@ -50,6 +51,13 @@ namespace knee_contact
     condense(const SparseMatrix<double>      &matrix,
              const AffineConstraints<double> &constraints,
              const bool                       keep_pattern = false);
+
+    /**
+     * The entries of @p pattern as a CsrMatrix without values: enough for
+     * the ordering and the symbolic analysis, without copying a matrix.
+     */
+    CsrMatrix
+    pattern_of(const SparsityPattern &pattern);
 
     /**
      * C0^T (d - C g) on the free dofs, zero on the constrained ones: the
