@@ -84,12 +84,12 @@ namespace knee_contact
     c              = prm.get_double("Active set constant") * max_youngs_modulus;
     tolerance      = prm.get_double("Tolerance");
     safeguard      = prm.get_bool("Cycle safeguard");
-    reference_solve = prm.get_bool("Reference solve");
+    reference_solve        = prm.get_bool("Reference solve");
     const std::string path = prm.get("Solver");
-    solver                 = path == "step-41"   ? LinearSolver::step41 :
-                             path == "sparse"    ? LinearSolver::sparse :
-                             path == "condensed" ? LinearSolver::condensed :
-                                                   LinearSolver::automatic;
+    solver                 = path == "step-41"     ? LinearSolver::step41
+                             : path == "sparse"    ? LinearSolver::sparse
+                             : path == "condensed" ? LinearSolver::condensed
+                                                   : LinearSolver::automatic;
     AssertThrow(c > 0, ExcMessage("Contact/Active set constant must be > 0"));
     prm.leave_subsection();
   }

@@ -124,7 +124,7 @@ namespace knee_contact
         for (const auto &[dof, a] : pairs[p].reduced_row)
           d.rows[p].emplace_back(d.local_of.at(dof), a);
 
-    Timer                 clock;
+    Timer      clock;
     const auto a = sparse_cholesky::condense(matrix, base);
     if (order.empty())
       d.order = sparse_cholesky::fill_reducing_ordering(a, d.dofs);
@@ -136,7 +136,7 @@ namespace knee_contact
             d.order.push_back(i);
         d.order.insert(d.order.end(), d.dofs.begin(), d.dofs.end());
       }
-    d.timings.ordering      = clock.wall_time();
+    d.timings.ordering = clock.wall_time();
 
     clock.restart();
     // The shift only needs to make the trailing block positive definite:
@@ -379,7 +379,7 @@ namespace knee_contact
   {
     Implementation &d = *implementation;
     Timer           clock;
-    const auto b = sparse_cholesky::condense(d.matrix, rhs, d.base);
+    const auto      b = sparse_cholesky::condense(d.matrix, rhs, d.base);
     // y = L^-1 P b; with L = [L_ii 0; L_ci L_cc], f = b_c - C_ci C_ii^-1 b_i
     // = L_cc y_c.
     d.forward.assign(b.begin(), b.end());
@@ -588,10 +588,10 @@ namespace knee_contact
   {
     AffineConstraints<double> constraints;
     ActiveSetSolver::make_constraints(base, pairs, active, constraints);
-    Timer                 clock;
-    const auto a     = sparse_cholesky::condense(matrix, constraints);
-    const auto b     = sparse_cholesky::condense(matrix, rhs, constraints);
-    const auto order = sparse_cholesky::fill_reducing_ordering(a, {});
+    Timer          clock;
+    const auto     a     = sparse_cholesky::condense(matrix, constraints);
+    const auto     b     = sparse_cholesky::condense(matrix, rhs, constraints);
+    const auto     order = sparse_cholesky::fill_reducing_ordering(a, {});
     SparseCholesky cholesky;
     cholesky.analyse(a, order, true);
     AssertThrow(cholesky.factorise(a),

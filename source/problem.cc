@@ -283,13 +283,13 @@ namespace knee_contact
           if (contact_solution.active[p])
             previous_contact.emplace_back(contact_pairs[p].position,
                                           contact_pairs[p].length);
-        record.n_cells      = triangulation.n_active_cells();
-        record.n_dofs       = dof_handler.n_dofs();
-        record.n_pairs      = contact_pairs.size();
+        record.n_cells        = triangulation.n_active_cells();
+        record.n_dofs         = dof_handler.n_dofs();
+        record.n_pairs        = contact_pairs.size();
         record.n_iterations   = contact_solution.n_iterations;
         record.solver         = solver_name;
         record.solver_figures = solver_figures;
-        record.energy       = results.energy;
+        record.energy         = results.energy;
         for (const auto &i : results.interfaces)
           record.peak_pressure = std::max(record.peak_pressure, i.max_pressure);
         for (const auto &phase : record.wall_time)

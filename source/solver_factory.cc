@@ -71,11 +71,10 @@ namespace knee_contact
             which     = name;
           }
       };
-      take(read_field("/proc/meminfo", "MemAvailable:", 1024.),
-           "MemAvailable");
+      take(read_field("/proc/meminfo", "MemAvailable:", 1024.), "MemAvailable");
       for (const auto &[limit, usage] :
-           {std::pair<std::string, std::string>{"/sys/fs/cgroup/memory.max",
-                                                "/sys/fs/cgroup/memory.current"},
+           {std::pair<std::string, std::string>{
+              "/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"},
             {"/sys/fs/cgroup/memory/memory.limit_in_bytes",
              "/sys/fs/cgroup/memory/memory.usage_in_bytes"}})
         {
@@ -170,15 +169,15 @@ namespace knee_contact
     Timer      clock;
     const auto pattern =
       sparse_cholesky::pattern_of(matrix.get_sparsity_pattern());
-    auto order          = sparse_cholesky::fill_reducing_ordering(pattern, {});
+    auto order = sparse_cholesky::fill_reducing_ordering(pattern, {});
     figures["choice_ordering"] = clock.wall_time();
     clock.restart();
     auto sparse =
       std::make_unique<SparseContactSystem>(matrix, base, pairs, order);
     figures["choice_analysis"] = clock.wall_time();
-    const double lnz       = sparse->nnz_factor();
-    const double fl        = sparse->flops();
-    const double nnz_lower = (pattern.column.size() + pattern.size()) / 2.;
+    const double lnz           = sparse->nnz_factor();
+    const double fl            = sparse->flops();
+    const double nnz_lower     = (pattern.column.size() + pattern.size()) / 2.;
 
     // Iterations the loop is expected to take: measured 1-5 from a guess
     // (a refined mesh's or load case's contact zone), up to 17 cold
@@ -194,9 +193,8 @@ namespace knee_contact
     // factor holds the dense k x k trailing block.
     const double matrix_bytes = 12. * nnz_lower + 12. * pattern.column.size();
     const double sparse_bytes = 9.6 * lnz + matrix_bytes;
-    const double condensed_bytes =
-      9.6 * (lnz + k * k / 2) + matrix_bytes +
-      8. * (3 * k * k + k * P + 2 * P * P);
+    const double condensed_bytes = 9.6 * (lnz + k * k / 2) + matrix_bytes +
+                                   8. * (3 * k * k + k * P + 2 * P * P);
     // Work [flops]: the condensed path factorises once (the trailing block
     // adds k^3/3), forms S (k^3), factorises S~ (k^3/3), W (2 k^2 P) and per
     // iteration the P x P LU (2/3 P^3); the sparse path factorises once per
@@ -219,26 +217,26 @@ namespace knee_contact
     const auto fits = [&](const double bytes) {
       return bytes <= 0.8 * available;
     };
-    figures["estimated_sparse_MB"]        = sparse_bytes / 1048576.;
-    figures["estimated_condensed_MB"]     = condensed_bytes / 1048576.;
-    figures["estimated_sparse_Gflop"]     = sparse_flops / 1e9;
-    figures["estimated_condensed_Gflop"]  = condensed_flops / 1e9;
-    figures["available_MB"]               = available / 1048576.;
+    figures["estimated_sparse_MB"]       = sparse_bytes / 1048576.;
+    figures["estimated_condensed_MB"]    = condensed_bytes / 1048576.;
+    figures["estimated_sparse_Gflop"]    = sparse_flops / 1e9;
+    figures["estimated_condensed_Gflop"] = condensed_flops / 1e9;
+    figures["available_MB"]              = available / 1048576.;
     figures["process_virtual_MB"] =
       read_field("/proc/self/status", "VmSize:", 1024.) / 1048576.;
-    figures["contact_unknowns"]           = k;
+    figures["contact_unknowns"] = k;
 
     SolverPath  path = requested;
     std::string reason;
     if (requested == SolverPath::automatic)
       {
-        path   = condensed_flops <= sparse_flops ? SolverPath::condensed :
-                                                   SolverPath::sparse;
-        reason = "estimated " + gigaflops(condensed_flops) + " condensed (k = " +
-                 std::to_string(int(k)) + " contact unknowns, P = " +
-                 std::to_string(int(P)) + " rows) against " +
-                 gigaflops(sparse_flops) + " sparse (factorisations of " +
-                 gigaflops(fl) + ")";
+        path   = condensed_flops <= sparse_flops ? SolverPath::condensed
+                                                 : SolverPath::sparse;
+        reason = "estimated " + gigaflops(condensed_flops) +
+                 " condensed (k = " + std::to_string(int(k)) +
+                 " contact unknowns, P = " + std::to_string(int(P)) +
+                 " rows) against " + gigaflops(sparse_flops) +
+                 " sparse (factorisations of " + gigaflops(fl) + ")";
         if (path == SolverPath::condensed && !fits(condensed_bytes) &&
             fits(sparse_bytes))
           {
@@ -259,8 +257,8 @@ namespace knee_contact
       reason = "as Contact/Solver says";
     // Neither fits: name the smaller of the two needs.
     if (!fits(condensed_bytes) && !fits(sparse_bytes))
-      path = condensed_bytes < sparse_bytes ? SolverPath::condensed :
-                                              SolverPath::sparse;
+      path = condensed_bytes < sparse_bytes ? SolverPath::condensed
+                                            : SolverPath::sparse;
     const double needed =
       path == SolverPath::condensed ? condensed_bytes : sparse_bytes;
     AssertThrow(fits(needed),
@@ -275,9 +273,11 @@ namespace knee_contact
       try
         {
           sparse.reset();
-          auto system =
-            std::make_unique<CondensedContactSystem>(matrix, base, pairs, order);
-          name = "condensed";
+          auto system = std::make_unique<CondensedContactSystem>(matrix,
+                                                                 base,
+                                                                 pairs,
+                                                                 order);
+          name        = "condensed";
           log << "   solver: condensed (" << reason << ")" << std::endl;
           return system;
         }

@@ -205,8 +205,8 @@ namespace knee_contact
         cholmod_free_factor(&factor, &common);
       if (matrix != nullptr)
         cholmod_free_sparse(&matrix, &common);
-      order                 = perm;
-      const std::size_t n   = a.size();
+      order               = perm;
+      const std::size_t n = a.size();
       // The upper triangle by columns is the lower one of C by rows.
       std::size_t nnz = 0;
       for (std::size_t i = 0; i < n; ++i)

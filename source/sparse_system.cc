@@ -135,8 +135,8 @@ namespace knee_contact
     Vector<double> x0, residual0;
     Vector<double> x;
 
-    double       ordering = 0, analysis = 0, factorisation = 0, solves = 0,
-           updates                                          = 0;
+    double ordering = 0, analysis = 0, factorisation = 0, solves = 0,
+           updates                = 0;
     unsigned int n_factorisations = 0, n_solves = 0, n_updates = 0,
                  n_corrections = 0, n_updates_on_factor = 0;
 
@@ -181,8 +181,7 @@ namespace knee_contact
 
 
   void
-  SparseContactSystem::Implementation::solve_base_homogeneous(
-    Vector<double> &b)
+  SparseContactSystem::Implementation::solve_base_homogeneous(Vector<double> &b)
   {
     condense_homogeneous(constraints, b);
     std::vector<double> z(b.begin(), b.end());
@@ -309,8 +308,7 @@ namespace knee_contact
     // at most the factor's memory.
     const double correction_flops = 16 * d.cholesky.nnz_factor();
     const double vector_MB        = 8. * d.matrix.m() / 1048576.;
-    if (!d.has_factor ||
-        (n_new + 1) * correction_flops > d.cholesky.flops() ||
+    if (!d.has_factor || (n_new + 1) * correction_flops > d.cholesky.flops() ||
         (d.corrections.size() + n_new) * vector_MB >
           std::max(d.cholesky.memory_MB(), 8 * vector_MB) ||
         changed.size() > 500)
@@ -354,11 +352,11 @@ namespace knee_contact
                 const auto &cj = d.corrections.at(changed[j]);
                 double      entry;
                 if (ci.released)
-                  entry = cj.released ? dot(ci.cv, cj.v) - dot(ci.cv, cj.w) :
-                                        dot(ci.v, cj.v) - dot(ci.cv, cj.w);
+                  entry = cj.released ? dot(ci.cv, cj.v) - dot(ci.cv, cj.w)
+                                      : dot(ci.v, cj.v) - dot(ci.cv, cj.w);
                 else
-                  entry = cj.released ? dot(ci.v, cj.v) - dot(ci.v, cj.w) :
-                                        -dot(ci.v, cj.w);
+                  entry = cj.released ? dot(ci.v, cj.v) - dot(ci.v, cj.w)
+                                      : -dot(ci.v, cj.w);
                 bordered[j * m + i] = entry;
               }
           }
@@ -391,13 +389,19 @@ namespace knee_contact
             for (std::size_t i = 0; i < m; ++i)
               {
                 const auto &c = d.corrections.at(changed[i]);
-                z[i]          = c.released ?
-                                  dot(c.v, r) :
-                                  d.pairs[changed[i]].reduced_gap -
-                                    dot(c.v, d.x) - dot(c.v, dx0);
+                z[i]          = c.released ? dot(c.v, r)
+                                           : d.pairs[changed[i]].reduced_gap -
+                                      dot(c.v, d.x) - dot(c.v, dx0);
               }
-            getrs("N", &n, &one, bordered.data(), &n, pivots.data(), z.data(),
-                  &n, &info);
+            getrs("N",
+                  &n,
+                  &one,
+                  bordered.data(),
+                  &n,
+                  pivots.data(),
+                  z.data(),
+                  &n,
+                  &info);
             AssertThrow(info == 0, ExcInternalError());
             d.x += dx0;
             for (std::size_t i = 0; i < m; ++i)

@@ -101,8 +101,8 @@ namespace
     out << "exit " << reference.status << " / " << other.status
         << ", iterations " << reference.contact.n_iterations << " / "
         << other.contact.n_iterations << ", active sets "
-        << (reference.contact.active == other.contact.active ? "equal" :
-                                                               "differ")
+        << (reference.contact.active == other.contact.active ? "equal"
+                                                             : "differ")
         << ", |dx|/|x| = " << dx << ", |dlambda|/|lambda| = " << dl;
     why = out.str();
     return ok;
@@ -111,8 +111,8 @@ namespace
   bool
   compare(const std::string &scene)
   {
-    using Path         = ActiveSetSolver::LinearSolver;
-    const Run step41   = run(scene, Path::step41);
+    using Path            = ActiveSetSolver::LinearSolver;
+    const Run    step41   = run(scene, Path::step41);
     unsigned int n_active = 0;
     for (const bool a : step41.contact.active)
       n_active += a;

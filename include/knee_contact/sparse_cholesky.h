@@ -115,9 +115,9 @@ namespace knee_contact
        * if not positive definite.
        */
       bool
-      factorise(const CsrMatrix   &a,
-                const std::size_t  n_shifted = 0,
-                const double       shift     = 0);
+      factorise(const CsrMatrix  &a,
+                const std::size_t n_shifted = 0,
+                const double      shift     = 0);
 
       /**
        * Numeric factorisation of @p a, whose sparsity pattern's entries
@@ -167,9 +167,9 @@ namespace knee_contact
       bool
       factorise_values();
 
-      cholmod_common  common;
-      cholmod_sparse *matrix = nullptr;
-      cholmod_factor *factor = nullptr;
+      cholmod_common   common;
+      cholmod_sparse  *matrix = nullptr;
+      cholmod_factor  *factor = nullptr;
       std::vector<int> order;
       double           lnz = 0, fl = 0;
     };
