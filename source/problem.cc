@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <future>
 #include <iomanip>
 #include <iostream>
 #include <map>
@@ -429,9 +430,17 @@ namespace knee_contact
     const std::vector<std::vector<CycleRecord>> &sequences,
     TimerOutput                                 &timer)
   {
+    // Declared first: if anything below throws, its destructor waits for
+    // the VTU thread before the objects it reads go.
+    std::future<void> vtu;
     {
       TimerOutput::Scope scope(timer, "output");
-      {
+      // The VTU (DataOut's patches and zlib: 95 % of the output time,
+      // measured 2.2 s of 2.3 s at 4.3e5 Hertz dofs) is written on a second
+      // thread while the other files, the summary and the pictures are
+      // made, and joined before the folder is committed; everything it
+      // reads is read-only by then.
+      vtu = std::async(std::launch::async, [&]() {
         TimerOutput::Scope part(timer, "output: vtu");
         output_writer.write_vtu(dof_handler,
                                 body_of_cell,
@@ -440,7 +449,7 @@ namespace knee_contact
                                 contact_pairs,
                                 contact_solution,
                                 results);
-      }
+      });
       {
         TimerOutput::Scope part(timer, "output: cells.npy");
         output_writer.write_cells(dof_handler,
@@ -490,15 +499,20 @@ namespace knee_contact
                                   solver_figures);
     };
     summary();
-    TimerOutput::Scope scope(timer, "pictures");
-    std::string        message;
-    if (!output_writer.run_script("plot_results.py", message) ||
-        (sequences.size() > 1 &&
-         !output_writer.run_script("plot_study.py", message)))
-      {
+    {
+      TimerOutput::Scope scope(timer, "pictures");
+      std::string        message;
+      if (!output_writer.run_script("plot_results.py", message) ||
+          (sequences.size() > 1 &&
+           !output_writer.run_script("plot_study.py", message)))
         output_writer.warn("no pictures: " + message);
-        summary();
-      }
+    }
+    {
+      TimerOutput::Scope scope(timer, "output");
+      vtu.get();
+    }
+    // Again, with the VTU's time and any warning of the pictures.
+    summary();
   }
 
 
