@@ -181,24 +181,23 @@ namespace knee_contact
 
     // Iterations the loop is expected to take: measured 1-5 from a guess
     // (a refined mesh's or load case's contact zone), up to 17 cold
-    // (scripts/benchmark.py); each costs the sparse path one numeric
-    // factorisation and the condensed path one P x P LU.
+    // (scripts/benchmark.py); each costs the condensed path one P x P LU.
     const double iterations = warm_start ? 3 : 10;
 
     // Peak memory beyond what is allocated now [bytes]: the factor's values
     // and indices (about 1.2 x 8 bytes per entry measured), CHOLMOD's copy of
     // the matrix (lower triangle, 12 bytes per entry), the condensed copy
-    // (all entries of the pattern, 12 bytes each); the condensed path adds
-    // L_cc, S, S~ (k^2 each), W (k P), G and its LU (P^2 each) and its
-    // factor holds the dense k x k trailing block.
+    // (all entries of the pattern, 12 bytes each); the sparse path's
+    // bordered-update vectors may take as much as its factor; the condensed
+    // path adds L_cc, S, S~ (k^2 each), W (k P), G and its LU (P^2 each) and
+    // its factor holds the dense k x k trailing block.
     const double matrix_bytes = 12. * nnz_lower + 12. * pattern.column.size();
-    const double sparse_bytes = 9.6 * lnz + matrix_bytes;
+    const double sparse_bytes = 2 * 9.6 * lnz + matrix_bytes;
     const double condensed_bytes = 9.6 * (lnz + k * k / 2) + matrix_bytes +
                                    8. * (3 * k * k + k * P + 2 * P * P);
     // Work [flops]: the condensed path factorises once (the trailing block
     // adds k^3/3), forms S (k^3), factorises S~ (k^3/3), W (2 k^2 P) and per
-    // iteration the P x P LU (2/3 P^3); the sparse path factorises once per
-    // iteration.
+    // iteration the P x P LU (2/3 P^3).
     // Dense BLAS-3 runs about 4x the flop rate of a supernodal factorisation
     // of a 2D mesh on this machine kind (measured: potrf/syrk at k = 5 000
     // 15-20 Gflop/s, CHOLMOD 2-5 Gflop/s), so dense flops count a quarter.

@@ -317,21 +317,22 @@ namespace knee_contact
         changed.clear();
       }
 
-    Timer clock;
-    if (!d.base_solved)
-      {
-        const auto b =
-          sparse_cholesky::condense(d.matrix, *d.rhs, d.constraints);
-        std::vector<double> z(b.begin(), b.end());
-        d.cholesky.solve(CHOLMOD_A, z);
-        d.x0.reinit(z.size());
-        std::copy(z.begin(), z.end(), d.x0.begin());
-        d.constraints.distribute(d.x0);
-        d.residual0.reinit(z.size());
-        d.matrix.residual(d.residual0, d.x0, *d.rhs);
-        d.base_solved = true;
-        ++d.n_solves;
-      }
+    Timer      clock;
+    const auto solve_base = [&]() {
+      if (d.base_solved)
+        return;
+      const auto b = sparse_cholesky::condense(d.matrix, *d.rhs, d.constraints);
+      std::vector<double> z(b.begin(), b.end());
+      d.cholesky.solve(CHOLMOD_A, z);
+      d.x0.reinit(z.size());
+      std::copy(z.begin(), z.end(), d.x0.begin());
+      d.constraints.distribute(d.x0);
+      d.residual0.reinit(z.size());
+      d.matrix.residual(d.residual0, d.x0, *d.rhs);
+      d.base_solved = true;
+      ++d.n_solves;
+    };
+    solve_base();
     d.solves += clock.wall_time();
 
     d.x = d.x0;
@@ -364,56 +365,66 @@ namespace knee_contact
         types::blas_int              info = 0;
         std::vector<types::blas_int> pivots(m);
         getrf(&n, &n, bordered.data(), &n, pivots.data(), &info);
-        AssertThrow(info == 0, ExcNotPositiveDefinite());
-
-        // x = x0 + (D - W) s - V mu, then one step of iterative refinement
-        // with the same bordered solve on the residual: rows that are
-        // nearly dependent (an added row beside a released one at the same
-        // slave vertex) cost the first solve digits (measured on
-        // knee_small: 4e-9 relative against a fresh factorisation, 1e-13
-        // after the step, the cost of one more solve with the factor).
-        Vector<double> r = d.residual0, dx0(r.size());
-        for (unsigned int step = 0; step < 2; ++step)
+        if (info != 0)
           {
-            // Base part: T K0^-1 T^T r (zero on the first step, where x0
-            // is the base solution).
-            dx0 = 0;
-            if (step > 0)
+            // A bordered system singular in floating point (rows dependent
+            // to round-off): the exact path, a factorisation of A.
+            d.factorise(active);
+            solve_base();
+            d.x = d.x0;
+            changed.clear();
+          }
+        else
+          {
+            // x = x0 + (D - W) s - V mu, then one step of iterative refinement
+            // with the same bordered solve on the residual: rows that are
+            // nearly dependent (an added row beside a released one at the same
+            // slave vertex) cost the first solve digits (measured on
+            // knee_small: 4e-9 relative against a fresh factorisation, 3e-12
+            // after the step, the cost of one more solve with the factor).
+            Vector<double> r = d.residual0, dx0(r.size());
+            for (unsigned int step = 0; step < 2; ++step)
               {
-                dx0 = r;
-                d.solve_base_homogeneous(dx0);
-                d.matrix.vmult(r, dx0);
-                r.sadd(-1., 1., residual_of_x);
+                // Base part: T K0^-1 T^T r (zero on the first step, where x0
+                // is the base solution).
+                dx0 = 0;
+                if (step > 0)
+                  {
+                    dx0 = r;
+                    d.solve_base_homogeneous(dx0);
+                    d.matrix.vmult(r, dx0);
+                    r.sadd(-1., 1., residual_of_x);
+                  }
+                std::vector<double> z(m);
+                for (std::size_t i = 0; i < m; ++i)
+                  {
+                    const auto &c = d.corrections.at(changed[i]);
+                    z[i]          = c.released ? dot(c.v, r)
+                                               : d.pairs[changed[i]].reduced_gap -
+                                          dot(c.v, d.x) - dot(c.v, dx0);
+                  }
+                getrs("N",
+                      &n,
+                      &one,
+                      bordered.data(),
+                      &n,
+                      pivots.data(),
+                      z.data(),
+                      &n,
+                      &info);
+                AssertThrow(info == 0, ExcInternalError());
+                d.x += dx0;
+                for (std::size_t i = 0; i < m; ++i)
+                  {
+                    const auto &c = d.corrections.at(changed[i]);
+                    d.x.add(-z[i], c.w);
+                    if (c.released)
+                      for (const auto &[dof, value] : c.v)
+                        d.x(dof) += z[i] * value;
+                  }
+                d.matrix.residual(residual_of_x, d.x, *d.rhs);
+                r = residual_of_x;
               }
-            std::vector<double> z(m);
-            for (std::size_t i = 0; i < m; ++i)
-              {
-                const auto &c = d.corrections.at(changed[i]);
-                z[i]          = c.released ? dot(c.v, r)
-                                           : d.pairs[changed[i]].reduced_gap -
-                                      dot(c.v, d.x) - dot(c.v, dx0);
-              }
-            getrs("N",
-                  &n,
-                  &one,
-                  bordered.data(),
-                  &n,
-                  pivots.data(),
-                  z.data(),
-                  &n,
-                  &info);
-            AssertThrow(info == 0, ExcInternalError());
-            d.x += dx0;
-            for (std::size_t i = 0; i < m; ++i)
-              {
-                const auto &c = d.corrections.at(changed[i]);
-                d.x.add(-z[i], c.w);
-                if (c.released)
-                  for (const auto &[dof, value] : c.v)
-                    d.x(dof) += z[i] * value;
-              }
-            d.matrix.residual(residual_of_x, d.x, *d.rhs);
-            r = residual_of_x;
           }
         d.updates += clock.wall_time();
         ++d.n_updates;
