@@ -311,9 +311,33 @@ namespace knee_contact
     direct.vmult(x, system_rhs);
     constraints.distribute(x);
 
-    Vector<double> residual(rhs->size());
-    matrix.residual(residual, x, *rhs);
-    lambda = ActiveSetSolver::multipliers(residual, base, pairs, active);
+    ActiveSetSolver::excess_and_multipliers(
+      matrix, *rhs, x, base, pairs, active, excess, lambda);
+  }
+
+
+
+  double
+  FullContactSystem::displacement_scale() const
+  {
+    return ActiveSetSolver::displacement_scale(pairs, x);
+  }
+
+
+
+  void
+  ActiveSetSolver::excess_and_multipliers(const SparseMatrix<double> &matrix,
+                                          const Vector<double>       &rhs,
+                                          const Vector<double>       &x,
+                                          const AffineConstraints<double> &base,
+                                          const std::vector<ContactPair> &pairs,
+                                          const std::vector<bool> &active,
+                                          std::vector<double>     &excess,
+                                          std::vector<double>     &lambda)
+  {
+    Vector<double> residual(rhs.size());
+    matrix.residual(residual, x, rhs);
+    lambda = multipliers(residual, base, pairs, active);
     excess.resize(pairs.size());
     for (unsigned int p = 0; p < pairs.size(); ++p)
       excess[p] = pairs[p].jump(x) - pairs[p].gap;
@@ -322,7 +346,8 @@ namespace knee_contact
 
 
   double
-  FullContactSystem::displacement_scale() const
+  ActiveSetSolver::displacement_scale(const std::vector<ContactPair> &pairs,
+                                      const Vector<double>           &x)
   {
     // Over the contact unknowns, as the condensed path sees them.
     double scale = 0;

@@ -366,14 +366,6 @@ namespace knee_contact
 
 
 
-  const CondensedContactSystem::Timings &
-  CondensedContactSystem::timings() const
-  {
-    return implementation->timings;
-  }
-
-
-
   void
   CondensedContactSystem::set_rhs(const Vector<double> &rhs)
   {

@@ -13,8 +13,7 @@ namespace knee_contact
   {
     CsrMatrix
     condense(const SparseMatrix<double>      &matrix,
-             const AffineConstraints<double> &constraints,
-             const bool                       keep_pattern)
+             const AffineConstraints<double> &constraints)
     {
       SparseMatrix<double> copy(matrix.get_sparsity_pattern());
       copy.copy_from(matrix);
@@ -23,15 +22,10 @@ namespace knee_contact
       const auto n = matrix.m();
       result.row_start.reserve(n + 1);
       result.row_start.push_back(0);
-      if (keep_pattern)
-        {
-          result.column.reserve(copy.n_nonzero_elements());
-          result.value.reserve(copy.n_nonzero_elements());
-        }
       for (types::global_dof_index i = 0; i < n; ++i)
         {
           for (auto it = copy.begin(i); it != copy.end(i); ++it)
-            if (keep_pattern || it->value() != 0 || it->column() == i)
+            if (it->value() != 0 || it->column() == i)
               {
                 result.column.push_back(it->column());
                 result.value.push_back(it->value());

@@ -109,6 +109,7 @@ namespace knee_contact
     const std::vector<ContactPair>  &pairs;
     const Vector<double>            *rhs = nullptr;
     sparse_cholesky::SparseCholesky  cholesky;
+    std::vector<int>                 order;
     /** C condensed under the base active set A0 of the factor. */
     SparseMatrix<double>      condensed;
     AffineConstraints<double> constraints;
@@ -239,8 +240,7 @@ namespace knee_contact
   SparseContactSystem::SparseContactSystem(
     const SparseMatrix<double>      &matrix,
     const AffineConstraints<double> &base,
-    const std::vector<ContactPair>  &pairs,
-    std::vector<int>                 order)
+    const std::vector<ContactPair>  &pairs)
     : implementation(std::make_unique<Implementation>(matrix, base, pairs))
   {
     Implementation &d = *implementation;
@@ -248,12 +248,19 @@ namespace knee_contact
     const auto pattern =
       sparse_cholesky::pattern_of(matrix.get_sparsity_pattern());
     Timer clock;
-    if (order.empty())
-      order = sparse_cholesky::fill_reducing_ordering(pattern, {});
+    d.order    = sparse_cholesky::fill_reducing_ordering(pattern, {});
     d.ordering = clock.wall_time();
     clock.restart();
-    d.cholesky.analyse(pattern, order, true);
+    d.cholesky.analyse(pattern, d.order, true);
     d.analysis = clock.wall_time();
+  }
+
+
+
+  const std::vector<int> &
+  SparseContactSystem::ordering() const
+  {
+    return implementation->order;
   }
 
 
@@ -431,15 +438,9 @@ namespace knee_contact
         ++d.n_updates_on_factor;
       }
 
-    // The multipliers from the residual d - C x at the eliminated dofs, the
-    // excess (A x - g)_p from the jumps, as the step-41 path.
     clock.restart();
-    Vector<double> residual(d.rhs->size());
-    d.matrix.residual(residual, d.x, *d.rhs);
-    lambda = ActiveSetSolver::multipliers(residual, d.base, d.pairs, active);
-    excess.resize(d.pairs.size());
-    for (unsigned int p = 0; p < d.pairs.size(); ++p)
-      excess[p] = d.pairs[p].jump(d.x) - d.pairs[p].gap;
+    ActiveSetSolver::excess_and_multipliers(
+      d.matrix, *d.rhs, d.x, d.base, d.pairs, active, excess, lambda);
     d.solves += clock.wall_time();
   }
 
@@ -448,13 +449,8 @@ namespace knee_contact
   double
   SparseContactSystem::displacement_scale() const
   {
-    const Implementation &d     = *implementation;
-    double                scale = 0;
-    for (const auto &pair : d.pairs)
-      if (pair.eliminated != numbers::invalid_dof_index)
-        for (const auto &entry : pair.reduced_row)
-          scale = std::max(scale, std::abs(d.x(entry.first)));
-    return scale;
+    return ActiveSetSolver::displacement_scale(implementation->pairs,
+                                               implementation->x);
   }
 
 

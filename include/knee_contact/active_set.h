@@ -135,6 +135,29 @@ namespace knee_contact
                 const std::vector<ContactPair>  &pairs,
                 const std::vector<bool>         &active);
 
+    /**
+     * What a path that solves for the whole x reports (step-41, sparse):
+     * the multipliers from the residual d - C x (multipliers()) and the
+     * excess (A x - g)_p of every pair from its jump.
+     */
+    static void
+    excess_and_multipliers(const SparseMatrix<double>      &matrix,
+                           const Vector<double>            &rhs,
+                           const Vector<double>            &x,
+                           const AffineConstraints<double> &base,
+                           const std::vector<ContactPair>  &pairs,
+                           const std::vector<bool>         &active,
+                           std::vector<double>             &excess,
+                           std::vector<double>             &lambda);
+
+    /**
+     * max |x_i| over the contact unknowns (every free dof of a row that
+     * can be active), the scale of the complementarity residual.
+     */
+    static double
+    displacement_scale(const std::vector<ContactPair> &pairs,
+                       const Vector<double>           &x);
+
   private:
     unsigned int max_iterations  = 50;
     double       c               = 0;

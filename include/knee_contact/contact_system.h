@@ -183,7 +183,7 @@ namespace knee_contact
     unsigned int
     n_contact_unknowns() const;
 
-    /** Wall times [s] of the set-up phases, for the benchmark. */
+    /** Wall times [s] of the set-up phases (statistics()). */
     struct Timings
     {
       double ordering      = 0;
@@ -195,8 +195,6 @@ namespace knee_contact
       double dense        = 0;
       double expansion    = 0;
     };
-    const Timings &
-    timings() const;
 
     /**
      * Memory [MB] of the sparse factor (values and row indices) and of the
@@ -231,13 +229,11 @@ namespace knee_contact
   {
   public:
     /**
-     * Order and analyse (no factorisation yet). @p order: a METIS ordering
-     * of the pattern computed by the caller (empty: compute it here).
+     * Order (METIS) and analyse (no factorisation yet).
      */
     SparseContactSystem(const SparseMatrix<double>      &matrix,
                         const AffineConstraints<double> &base,
-                        const std::vector<ContactPair>  &pairs,
-                        std::vector<int>                 order = {});
+                        const std::vector<ContactPair>  &pairs);
     ~SparseContactSystem() override;
 
     void
@@ -256,6 +252,13 @@ namespace knee_contact
 
     std::map<std::string, double>
     statistics() const override;
+
+    /**
+     * The fill-reducing ordering of every dof (perm[new] = dof), which the
+     * condensed path reuses.
+     */
+    const std::vector<int> &
+    ordering() const;
 
     /** Entries of the factor and flops of one factorisation. */
     double

@@ -41,16 +41,13 @@ namespace knee_contact
     /**
      * C under @p constraints, C0^T C C0 on the free dofs and a decoupled
      * diagonal on the constrained ones, as AffineConstraints::condense()
-     * makes it. With @p keep_pattern false only the nonzero entries are
-     * kept (the pattern of the matrix also holds the couplings of every
-     * active set, which would only add fill); with true every entry of the
-     * pattern is kept, so that matrices of different active sets share one
-     * pattern and one symbolic analysis.
+     * makes it; only its nonzero entries are kept (the pattern of the
+     * matrix also holds the couplings of every active set, which would
+     * only add fill).
      */
     CsrMatrix
     condense(const SparseMatrix<double>      &matrix,
-             const AffineConstraints<double> &constraints,
-             const bool                       keep_pattern = false);
+             const AffineConstraints<double> &constraints);
 
     /**
      * The entries of @p pattern as a CsrMatrix without values: enough for
