@@ -1,6 +1,6 @@
-#include <knee_contact/input.h>
-#include <knee_contact/interruption.h>
-#include <knee_contact/problem.h>
+#include <knee_contact/core/input.h>
+#include <knee_contact/core/interruption.h>
+#include <knee_contact/core/problem.h>
 
 #include <deal.II/base/multithread_info.h>
 

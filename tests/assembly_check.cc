@@ -21,7 +21,7 @@
 // entries, the same pairs, the same gaps and lengths; and the mortar rows of
 // the same scene (see below).
 
-#include <knee_contact/problem.h>
+#include <knee_contact/core/problem.h>
 
 #include <deal.II/lac/full_matrix.h>
 

@@ -8,7 +8,7 @@ import glob
 import re
 import sys
 
-sources = {p: open(p).read() for p in glob.glob(sys.argv[1] + "/*.cc")}
+sources = {p: open(p).read() for p in glob.glob(sys.argv[1] + "/**/*.cc", recursive=True)}
 text = "\n".join(sources.values())
 declared = set(re.findall(r'declare_entry\(\s*"([^"]+)"', text))
 read = set(re.findall(r'(?:get(?:_double|_integer|_bool)?|optional)\(\s*"([^"]+)"', text))

@@ -7,7 +7,7 @@
 // 1e-10 relative, and so do the active sets. Done for node-to-segment rows
 // (qp_scene.prm) and for mortar rows (qp_scene_mortar.prm).
 
-#include <knee_contact/problem.h>
+#include <knee_contact/core/problem.h>
 
 #include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/lapack_full_matrix.h>

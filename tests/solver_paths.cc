@@ -13,7 +13,7 @@
 // larger (measured: knee_small, r = 338: 1.4e-10; knee_frontal_small,
 // r = 588: 1.0e-10; contrast_1e6: 1.3e-9).
 
-#include <knee_contact/problem.h>
+#include <knee_contact/core/problem.h>
 
 #include <algorithm>
 #include <cmath>

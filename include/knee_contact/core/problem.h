@@ -1,0 +1,252 @@
+#ifndef knee_contact_problem_h
+#define knee_contact_problem_h
+
+#include <knee_contact/solver/active_set.h>
+#include <knee_contact/physics/boundary_conditions.h>
+#include <knee_contact/contact/contact.h>
+#include <knee_contact/solver/contact_system.h>
+#include <knee_contact/postprocess/load_cases.h>
+#include <knee_contact/physics/materials.h>
+#include <knee_contact/mesh/mesh.h>
+#include <knee_contact/postprocess/output.h>
+#include <knee_contact/postprocess/refinement.h>
+#include <knee_contact/postprocess/results.h>
+#include <knee_contact/postprocess/study.h>
+#include <knee_contact/postprocess/verification.h>
+
+#include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/timer.h>
+
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/sparse_matrix.h>
+#include <deal.II/lac/sparsity_pattern.h>
+#include <deal.II/lac/vector.h>
+
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/fe/fe_system.h>
+#include <deal.II/grid/tria.h>
+
+#include <map>
+#include <memory>
+#include <ostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace knee_contact
+{
+  using namespace dealii;
+
+  /**
+   * Exit codes of the program.
+   */
+  enum ExitCode : int
+  {
+    success             = 0,
+    input_error         = 1,
+    verification_failed = 2,
+    not_converged       = 3,
+    internal_error      = 4
+  };
+
+
+
+  /**
+   * The contact problem of the seed: s linear elastic bodies with
+   * Gamma_u, Gamma_tau, Gamma_o and unilateral contact on Gamma_c, solved
+   * on one or more meshes. It orchestrates: scene -> dofs and constraints
+   * -> assembled system -> active-set loop -> results -> files. Each step
+   * is done by the class of its concept.
+   */
+  class ContactProblem
+  {
+  public:
+    /**
+     * How many numbered subsections a scene file has; read in a first pass
+     * so that the second pass can declare exactly those.
+     */
+    struct Counts
+    {
+      unsigned int n_materials  = 1;
+      unsigned int n_conditions = 1;
+      unsigned int n_interfaces = 1;
+    };
+
+    static Counts
+    read_counts(const std::string &scene_file);
+
+    static void
+    declare_parameters(ParameterHandler &prm, const Counts &counts);
+
+    /**
+     * Read the scene file; throws a one-line message on bad input.
+     */
+    explicit ContactProblem(const std::string &scene_file);
+
+    /**
+     * Build the mesh and check it against the scene, without solving.
+     */
+    void
+    check_scene();
+
+    /**
+     * Solve on every refinement cycle, write the files of the last one,
+     * and return an ExitCode.
+     */
+    int
+    run();
+
+    // Access for unit tests.
+    ActiveSetSolver &
+    contact_solver()
+    {
+      return active_set_solver;
+    }
+    const Materials &
+    materials_of() const
+    {
+      return materials;
+    }
+    const DoFHandler<2> &
+    dof_handler_of() const
+    {
+      return dof_handler;
+    }
+    const SparseMatrix<double> &
+    matrix() const
+    {
+      return system_matrix;
+    }
+    const Vector<double> &
+    rhs() const
+    {
+      return system_rhs;
+    }
+    const AffineConstraints<double> &
+    base_constraints() const
+    {
+      return constraints;
+    }
+    const std::vector<ContactPair> &
+    pairs() const
+    {
+      return contact_pairs;
+    }
+    const Vector<double> &
+    solution() const
+    {
+      return displacement;
+    }
+    const ContactSolution &
+    contact() const
+    {
+      return contact_solution;
+    }
+
+  private:
+    void
+    make_mesh();
+
+    void
+    setup_system();
+
+    /**
+     * Solve on Refinement::n_cycles meshes refined by @p strategy, starting
+     * from the coarse mesh; one record per cycle. Leaves the last solution
+     * in place and its derived quantities in @p results.
+     */
+    std::vector<CycleRecord>
+    run_cycles(const Refinement::Strategy strategy,
+               TimerOutput               &timer,
+               Results                   &results);
+
+    /**
+     * Solve the contact problem for the current system_rhs, from the active
+     * set @p guess: with a new contact system (factorisation) if
+     * @p new_matrix, else reusing the last one (a further load case).
+     */
+    void
+    solve_contact(const std::vector<bool> &guess, const bool new_matrix);
+
+    /** The derived quantities (compute_results()) of the current solution. */
+    Results
+    current_results() const;
+
+    /** Evaluate loads and exact solutions at load parameter @p t. */
+    void
+    set_load_parameter(const double t);
+
+    /**
+     * The files of one solution into the output writer's current folder:
+     * VTU, cells.npy, contact CSVs, study.csv for a study, summary.json and
+     * pictures.
+     */
+    void
+    write_result_set(const Results                               &results,
+                     const std::vector<std::vector<CycleRecord>> &sequences,
+                     TimerOutput                                 &timer);
+
+    /**
+     * The further load cases on the last mesh, after the first one was
+     * solved with @p first_results; writes one result set per case,
+     * load_cases.csv, load_cases.pvd and the load-case plot. Returns the
+     * number of failed verification checks.
+     */
+    unsigned int
+    run_load_cases(const Results                               &first_results,
+                   const std::vector<std::vector<CycleRecord>> &sequences,
+                   TimerOutput                                 &timer);
+
+    std::ostream &
+    log() const;
+
+    /**
+     * The results table on the terminal; in test mode also the pressure
+     * profile of every interface.
+     */
+    void
+    print_results(const Results &results) const;
+
+    std::string scene_file;
+
+    MeshInput          mesh_input;
+    Materials          materials;
+    BoundaryConditions boundary_conditions;
+    ContactInterfaces  contact_interfaces;
+    ActiveSetSolver    active_set_solver;
+    LoadCases          load_cases;
+    OutputWriter       output_writer;
+    Verification       verification;
+    Refinement         refinement;
+
+    Triangulation<2> triangulation;
+    // FE_Q(1)^2 or FE_SimplexP(1)^2, by the mesh's cells (make_mesh).
+    std::unique_ptr<FiniteElement<2>> fe;
+    DoFHandler<2>                     dof_handler;
+    std::vector<unsigned int>         body_of_cell;
+    unsigned int                      n_bodies = 0;
+    std::vector<std::string>          body_names;
+
+    AffineConstraints<double> constraints;
+    std::vector<ContactPair>  contact_pairs;
+    SparsityPattern           sparsity_pattern;
+    SparseMatrix<double>      system_matrix;
+    Vector<double>            system_rhs;
+    Vector<double>            displacement;
+    ContactSolution           contact_solution;
+    /** The last cycle's factorised system, kept for further load cases. */
+    std::unique_ptr<ContactSystem> contact_system;
+    /**
+     * The last solve's solver figures for summary.json: phase times [s],
+     * number of contact unknowns, reference solve (see ActiveSetSolver).
+     */
+    std::map<std::string, double> solver_figures;
+    std::string                   solver_name;
+    /** Positions and slave lengths of the last cycle's active pairs. */
+    std::vector<std::pair<Point<2>, double>> previous_contact;
+
+    mutable std::ostringstream quiet;
+  };
+} // namespace knee_contact
+
+#endif

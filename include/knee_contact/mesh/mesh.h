@@ -1,0 +1,130 @@
+#ifndef knee_contact_mesh_h
+#define knee_contact_mesh_h
+
+#include <knee_contact/mesh/mesh_readers.h>
+
+#include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/point.h>
+
+#include <deal.II/grid/tria.h>
+
+#include <array>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace knee_contact
+{
+  using namespace dealii;
+
+  /**
+   * One Triangulation<2> holding all bodies: read from a mesh file (Gmsh
+   * .msh or .geo, which the gmsh program meshes first; Abaqus .inp; legacy
+   * VTK .vtk) or generated from rectangles. Physical
+   * surfaces are material ids and physical curves boundary ids. Bodies that
+   * share vertices are bonded; bodies in contact must have distinct
+   * (possibly coincident) vertices on their interface.
+   */
+  class MeshInput
+  {
+  public:
+    static void
+    declare_parameters(ParameterHandler &prm);
+
+    void
+    parse_parameters(ParameterHandler &prm, const std::string &scene_file);
+
+    /**
+     * Build the coarse mesh, attach the circular manifolds and refine
+     * globally as asked.
+     */
+    void
+    create(Triangulation<2> &triangulation) const;
+
+  private:
+    struct Rectangle
+    {
+      Point<2>                          lower, upper;
+      unsigned int                      n_x = 1, n_y = 1;
+      types::material_id                material_id = 0;
+      unsigned int                      group       = 0;
+      std::array<types::boundary_id, 4> boundary_ids{}; // left right bottom top
+    };
+
+    /**
+     * Read Mesh/File by its extension; split triangles into quadrilaterals
+     * where the solver needs them (mixed meshes, Triangles =
+     * quadrilaterals, adaptive refinement).
+     */
+    void
+    read_file(Triangulation<2> &triangulation) const;
+
+    mesh_readers::Description
+    read_gmsh() const;
+
+    /**
+     * Split @p mesh's triangles where needed (see read_file) and make
+     * @p triangulation of it.
+     */
+    void
+    finish(mesh_readers::Description &mesh,
+           Triangulation<2>          &triangulation) const;
+
+    mesh_readers::Description
+    read_vtk() const;
+
+    void
+    make_rectangles(Triangulation<2> &triangulation) const;
+
+    enum class Source
+    {
+      rectangles,
+      file
+    };
+
+    Source                                 source = Source::rectangles;
+    std::string                            file;
+    std::vector<std::string>               gmsh_arguments;
+    double                                 gmsh_time_limit = 300;
+    std::vector<Rectangle>                 rectangles;
+    double                                 rotation_degrees = 0;
+    unsigned int                           n_refinements    = 0;
+    std::map<types::boundary_id, Point<2>> circular_boundaries;
+    bool                                   split_triangles = false;
+    enum class RectangleCells
+    {
+      quadrilaterals,
+      triangles,
+      mixed
+    } rectangle_cells = RectangleCells::quadrilaterals;
+    std::map<std::string, unsigned int> abaqus_element_sets;
+    std::map<std::string, unsigned int> abaqus_boundary_sets;
+
+  public:
+    /**
+     * Set when the scene refines adaptively: deal.II 9.4's Kelly estimator
+     * cannot integrate over the hanging faces of triangles, so a triangle
+     * mesh is then split into quadrilaterals.
+     */
+    bool adaptive = false;
+  };
+
+
+
+  /**
+   * The body of each active cell (index by active_cell_index()): bodies are
+   * the connected sets of cells that share vertices. Numbered 0, 1, ... in the
+   * order of their first cell, so numbering is deterministic.
+   */
+  std::vector<unsigned int>
+  compute_body_ids(const Triangulation<2> &triangulation,
+                   unsigned int           &n_bodies);
+  /**
+   * Refuse a mesh with an inverted, degenerate or non-convex cell, with the
+   * cell's place (on the coarse mesh and after every refinement).
+   */
+  void
+  check_cells(const Triangulation<2> &triangulation);
+} // namespace knee_contact
+
+#endif

@@ -1,0 +1,57 @@
+#ifndef knee_contact_elasticity_h
+#define knee_contact_elasticity_h
+
+#include <knee_contact/physics/boundary_conditions.h>
+#include <knee_contact/physics/materials.h>
+
+#include <deal.II/lac/sparse_matrix.h>
+#include <deal.II/lac/vector.h>
+
+#include <deal.II/dofs/dof_handler.h>
+
+namespace knee_contact
+{
+  using namespace dealii;
+
+  /**
+   * Assembles the seed's quadratic functional L(v) = 1/2 a(v,v) - L(v), its
+   * eq. (7), as the stiffness matrix C and load vector d of
+   * f(x) = 1/2 x^T C x - x^T d, without any constraint applied: the
+   * active-set loop condenses a copy for each active set and needs the
+   * unconstrained pair for the residual d - C x (reactions and contact
+   * forces).
+   */
+  class ElasticityAssembler
+  {
+  public:
+    ElasticityAssembler(const Materials          &materials,
+                        const BoundaryConditions &boundary_conditions);
+
+    /**
+     * @p matrix must be initialised with a sparsity pattern; it and @p rhs
+     * are overwritten. Cells are assembled in parallel by WorkStream.
+     */
+    void
+    assemble(const DoFHandler<2>  &dof_handler,
+             SparseMatrix<double> &matrix,
+             Vector<double>       &rhs) const;
+
+    /**
+     * Only the load vector d, for a further load case on the same mesh:
+     * the body forces and tractions at the load parameter last set.
+     */
+    void
+    assemble_rhs(const DoFHandler<2> &dof_handler, Vector<double> &rhs) const;
+
+  private:
+    void
+    assemble(const DoFHandler<2>  &dof_handler,
+             SparseMatrix<double> *matrix,
+             Vector<double>       &rhs) const;
+
+    const Materials          &materials;
+    const BoundaryConditions &boundary_conditions;
+  };
+} // namespace knee_contact
+
+#endif

@@ -1,0 +1,166 @@
+#ifndef knee_contact_output_h
+#define knee_contact_output_h
+
+#include <knee_contact/solver/active_set.h>
+#include <knee_contact/contact/contact.h>
+#include <knee_contact/physics/materials.h>
+#include <knee_contact/core/result_folder.h>
+#include <knee_contact/postprocess/results.h>
+
+#include <deal.II/base/parameter_handler.h>
+
+#include <deal.II/lac/vector.h>
+
+#include <deal.II/dofs/dof_handler.h>
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace knee_contact
+{
+  using namespace dealii;
+
+  /**
+   * The files of a run, in the output folder: solution.vtu, one
+   * contact_<interface>.csv per interface and summary.json. All files of a
+   * run go into a staging folder that replaces the output folder in one
+   * step at the end (ResultFolder), so the folder never mixes two runs.
+   */
+  class OutputWriter
+  {
+  public:
+    static void
+    declare_parameters(ParameterHandler &prm);
+
+    void
+    parse_parameters(ParameterHandler &prm, const std::string &scene_file);
+
+    /**
+     * Lock the output folder and create the run's staging folder beside it
+     * (ResultFolder); throw a one-line error if either is impossible.
+     */
+    void
+    prepare();
+
+    /**
+     * Swap the complete result set in for the output folder's previous one.
+     */
+    void
+    commit();
+
+    void
+    write_vtu(const DoFHandler<2>             &dof_handler,
+              const std::vector<unsigned int> &body_of_cell,
+              const Vector<double>            &solution,
+              const Materials                 &materials,
+              const std::vector<ContactPair>  &pairs,
+              const ContactSolution           &contact,
+              const Results                   &results) const;
+
+    void
+    write_contact_csv(const ContactInterfaces        &interfaces,
+                      const std::vector<ContactPair> &pairs,
+                      const Vector<double>           &solution,
+                      const ContactSolution          &contact,
+                      const Results                  &results) const;
+
+    /**
+     * cells.csv: every cell's material and body id and, at its vertices
+     * (counter-clockwise), position, displacement and tau_yy; the data of the
+     * pictures.
+     */
+    void
+    write_cells(const DoFHandler<2>             &dof_handler,
+                const std::vector<unsigned int> &body_of_cell,
+                const Vector<double>            &solution,
+                const Results                   &results) const;
+
+    /**
+     * Run scripts/@p script (Debian's python3 with matplotlib) on the
+     * folder, e.g. plot_results.py: deformation, tau_yy and contact pressure
+     * pictures. Does nothing if pictures are off. Returns false, with the
+     * script's last line in @p message, if it failed.
+     */
+    bool
+    run_script(const std::string &script, std::string &message) const;
+
+    /**
+     * Write the following files (and pictures) into the folder @p name of
+     * the result set, created now; "" for the result set itself. Load
+     * cases write one such folder per case.
+     */
+    void
+    set_subfolder(const std::string &name);
+
+    /**
+     * Write the file @p name into the run's staging folder.
+     */
+    void
+    write_file(const std::string                         &name,
+               const std::function<void(std::ostream &)> &write) const;
+
+    /**
+     * summary.json; @p solver names the linear solver and @p solver_figures
+     * its phase times and sizes (section "solver").
+     */
+    void
+    write_summary(const Results                       &results,
+                  const ContactSolution               &contact,
+                  const Materials                     &materials,
+                  const std::map<std::string, double> &wall_times,
+                  const std::string                   &solver,
+                  const std::map<std::string, double> &solver_figures) const;
+
+    /**
+     * Print a warning on the terminal and keep it for summary.json
+     * ("warnings"): for what is suspicious but not refused.
+     */
+    void
+    warn(const std::string &message);
+
+    bool
+    test_mode() const
+    {
+      return terminal_test;
+    }
+
+    const std::string &
+    folder() const
+    {
+      return output_folder;
+    }
+
+    bool
+    enabled() const
+    {
+      return write_files;
+    }
+
+  private:
+    /** The path of @p name in the staging folder. */
+    std::string
+    staging(const std::string &name) const;
+
+    /** The path @p name will have in the output folder, for messages. */
+    std::string
+    final_path(const std::string &name) const;
+
+    /** "" or the current case's folder with a trailing '/'. */
+    std::string subfolder;
+
+    std::unique_ptr<ResultFolder>                 result_folder;
+    std::vector<std::string>                      warnings;
+    double                                        picture_time_limit = 600;
+    std::string                                   output_folder;
+    double                                        magnification = 10;
+    bool                                          pictures      = true;
+    std::vector<std::pair<std::string, Point<2>>> labels;
+    bool                                          terminal_test = false;
+    bool                                          write_files   = true;
+  };
+} // namespace knee_contact
+
+#endif

@@ -1,0 +1,90 @@
+#ifndef knee_contact_refinement_h
+#define knee_contact_refinement_h
+
+#include <knee_contact/solver/active_set.h>
+#include <knee_contact/contact/contact.h>
+#include <knee_contact/physics/materials.h>
+
+#include <deal.II/base/parameter_handler.h>
+
+#include <deal.II/lac/vector.h>
+
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/grid/tria.h>
+
+#include <string>
+
+namespace knee_contact
+{
+  using namespace dealii;
+
+  /**
+   * How the mesh changes between cycles: every cell refined (global), or
+   * the cells that carry the largest share of an a-posteriori error
+   * estimate (adaptive), or both sequences one after the other (compare,
+   * the speed-against-error study).
+   */
+  class Refinement
+  {
+  public:
+    enum class Strategy
+    {
+      global,
+      adaptive,
+      compare
+    };
+
+    static void
+    declare_parameters(ParameterHandler &prm);
+
+    void
+    parse_parameters(ParameterHandler &prm);
+
+    /**
+     * Refine @p triangulation once with @p strategy (global or adaptive)
+     * using the solution on it. The adaptive indicator is deal.II's Kelly
+     * estimator of the displacement gradient jumps, weighted by sqrt(E) of
+     * each cell so that it estimates the energy norm error a(e, e)^1/2
+     * across materials; refinement by fixed fraction of the estimate.
+     */
+    void
+    refine(const Strategy                  strategy,
+           Triangulation<2>               &triangulation,
+           const DoFHandler<2>            &dof_handler,
+           const Vector<double>           &solution,
+           const Materials                &materials,
+           const ContactInterfaces        &interfaces,
+           const std::vector<ContactPair> &pairs,
+           const ContactSolution          &contact) const;
+
+    static std::string
+    name(const Strategy strategy);
+
+    unsigned int n_cycles = 1;
+    /** Cycles of the adaptive sequence (Strategy = adaptive or compare). */
+    unsigned int n_adaptive_cycles = 1;
+    Strategy     strategy          = Strategy::global;
+
+  private:
+    /**
+     * Mark the cells across each contact interface whose faces lie opposite
+     * a marked boundary cell and are longer than its children will be, in
+     * both directions until nothing changes, so the two sides stay about
+     * equally fine (node-to-segment pairing handles any mismatch left).
+     */
+    void
+    mark_partners(Triangulation<2>        &triangulation,
+                  const ContactInterfaces &interfaces) const;
+
+    double refine_fraction = 0.5;
+    /** Refinement/Indicator. */
+    enum class Indicator
+    {
+      kelly,
+      kelly_contact
+    };
+    Indicator indicator = Indicator::kelly_contact;
+  };
+} // namespace knee_contact
+
+#endif

@@ -1,0 +1,171 @@
+#ifndef knee_contact_active_set_h
+#define knee_contact_active_set_h
+
+#include <knee_contact/contact/contact.h>
+#include <knee_contact/solver/contact_system.h>
+#include <knee_contact/physics/rigid_modes.h>
+
+#include <deal.II/base/parameter_handler.h>
+
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/sparse_matrix.h>
+#include <deal.II/lac/sparsity_pattern.h>
+#include <deal.II/lac/vector.h>
+
+#include <deal.II/dofs/dof_handler.h>
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace knee_contact
+{
+  using namespace dealii;
+
+  /**
+   * What the active-set loop found.
+   */
+  struct ContactSolution
+  {
+    std::vector<bool>   active;
+    std::vector<double> lambda; // contact force of each pair [N/m], >= 0
+    unsigned int        n_iterations = 0;
+    /** Iteration at which a cycle switched on the safeguard; 0: never. */
+    unsigned int safeguard_from = 0;
+    bool         converged      = true;
+    std::string  failure; // why not, if not converged
+    double       complementarity = 0;
+    double       max_penetration = 0; // max (A x - g)_p [m]
+  };
+
+
+
+  /**
+   * The primal-dual active set method of step-41/42 for the seed's QP
+   * min 1/2 x^T C x - x^T d subject to A x <= g (its eq. (13) and P_d).
+   * Each iteration solves with the active rows as equalities (a
+   * ContactSystem: condensed onto the contact unknowns, or step-41's
+   * UMFPACK solve of the whole system), recovers the multipliers from the
+   * residual d - C x, and updates
+   *   A = {p : lambda_p + c ((A x)_p - g_p) > 0}.
+   * deal.II has no contact solver for node pairs between bodies, so the
+   * loop is written here.
+   */
+  class ActiveSetSolver
+  {
+  public:
+    static void
+    declare_parameters(ParameterHandler &prm);
+
+    void
+    parse_parameters(ParameterHandler &prm, const double max_youngs_modulus);
+
+    /**
+     * How the linear systems of the loop are solved (see ContactSystem).
+     */
+    using LinearSolver = SolverPath;
+
+    LinearSolver
+    linear_solver() const
+    {
+      return solver;
+    }
+
+    /**
+     * Whether to time one linear solve with the final active set held
+     * fixed (the benchmark's reference).
+     */
+    bool
+    measure_reference() const
+    {
+      return reference_solve;
+    }
+
+    /** Override the scene's Contact/Solver (tests compare the two). */
+    void
+    set_linear_solver(const LinearSolver linear_solver)
+    {
+      solver = linear_solver;
+    }
+
+    /**
+     * Run the loop on @p system. @p force_scale is |d|_inf (the load
+     * scale of the round-off test for unloaded contact). @p guess marks
+     * the pairs to start active (the contact zone of a coarser mesh, the
+     * active set of the previous load case); empty: start from the pairs
+     * that touch (g_p <= 0). @p log receives one line per
+     * iteration. The solution is then system.solution().
+     */
+    ContactSolution
+    solve(ContactSystem                   &system,
+          const double                     force_scale,
+          const AffineConstraints<double> &base,
+          const std::vector<ContactPair>  &pairs,
+          const RigidModes                &rigid_modes,
+          const std::vector<bool>         &guess,
+          std::ostream                    &log) const;
+
+    /**
+     * One sparsity pattern for the condensed systems of every active set of
+     * @p pairs under @p base (see the comment in the code).
+     */
+    static void
+    make_sparsity_pattern(const DoFHandler<2>             &dof_handler,
+                          const AffineConstraints<double> &base,
+                          const std::vector<ContactPair>  &pairs,
+                          SparsityPattern                 &sparsity_pattern);
+
+    /**
+     * The constraints of @p base plus the active rows of @p pairs, closed.
+     */
+    static void
+    make_constraints(const AffineConstraints<double> &base,
+                     const std::vector<ContactPair>  &pairs,
+                     const std::vector<bool>         &active,
+                     AffineConstraints<double>       &constraints);
+
+    /**
+     * The multipliers lambda_p of the active pairs from the residual
+     * r = d - C x: C0^T r = C0^T A^T lambda at the eliminated dofs, where C0
+     * maps free dofs to all under Gamma_u/Gamma_o.
+     */
+    static std::vector<double>
+    multipliers(const Vector<double>            &residual,
+                const AffineConstraints<double> &base,
+                const std::vector<ContactPair>  &pairs,
+                const std::vector<bool>         &active);
+
+    /**
+     * What a path that solves for the whole x reports (step-41, sparse):
+     * the multipliers from the residual d - C x (multipliers()) and the
+     * excess (A x - g)_p of every pair from its jump.
+     */
+    static void
+    excess_and_multipliers(const SparseMatrix<double>      &matrix,
+                           const Vector<double>            &rhs,
+                           const Vector<double>            &x,
+                           const AffineConstraints<double> &base,
+                           const std::vector<ContactPair>  &pairs,
+                           const std::vector<bool>         &active,
+                           std::vector<double>             &excess,
+                           std::vector<double>             &lambda);
+
+    /**
+     * max |x_i| over the contact unknowns (every free dof of a row that
+     * can be active), the scale of the complementarity residual.
+     */
+    static double
+    displacement_scale(const std::vector<ContactPair> &pairs,
+                       const Vector<double>           &x);
+
+  private:
+    unsigned int max_iterations  = 50;
+    double       c               = 0;
+    double       tolerance       = 1e-10;
+    bool         safeguard       = true;
+    LinearSolver solver          = LinearSolver::automatic;
+    bool         reference_solve = false;
+  };
+} // namespace knee_contact
+
+#endif

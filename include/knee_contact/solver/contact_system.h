@@ -1,0 +1,332 @@
+#ifndef knee_contact_contact_system_h
+#define knee_contact_contact_system_h
+
+#include <knee_contact/contact/contact.h>
+
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/sparse_matrix.h>
+#include <deal.II/lac/vector.h>
+
+#include <map>
+#include <memory>
+#include <ostream>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace knee_contact
+{
+  using namespace dealii;
+
+  /**
+   * The linear algebra of one active-set iteration, the solver seam: given
+   * which contact rows hold as equalities, solve
+   *   min 1/2 x^T C x - x^T d  subject to  Gamma_u/Gamma_o/hanging-node
+   *   constraints and a'_p . x = g'_p for the active pairs p,
+   * and report each pair's excess (A x - g)_p and the active multipliers.
+   * ActiveSetSolver runs the same loop on any implementation.
+   *
+   * The classes see only matrices and rows (no geometry), so they do not
+   * depend on the dimension.
+   */
+  class ContactSystem
+  {
+  public:
+    virtual ~ContactSystem() = default;
+
+    DeclExceptionMsg(ExcNotPositiveDefinite,
+                     "the stiffness matrix with the contact unknowns held "
+                     "is singular");
+
+    /**
+     * A load case: the load vector d of the following solves (the matrix and
+     * the constraints stay). Must be called before the first solve().
+     */
+    virtual void
+    set_rhs(const Vector<double> &rhs) = 0;
+
+    /**
+     * Solve with the rows of the pairs marked in @p active as equalities;
+     * @p excess receives (A x - g)_p for every pair, @p lambda the
+     * multiplier of every active pair (zero for the others).
+     */
+    virtual void
+    solve(const std::vector<bool> &active,
+          std::vector<double>     &excess,
+          std::vector<double>     &lambda) = 0;
+
+    /**
+     * max |x_i| of the last solve over the contact unknowns (the free dofs
+     * of the contact rows): the scale of the complementarity residual.
+     */
+    virtual double
+    displacement_scale() const = 0;
+
+    /**
+     * The whole displacement of the last solve, every constraint
+     * distributed.
+     */
+    virtual void
+    solution(Vector<double> &x) = 0;
+
+    /**
+     * The path's own figures for summary.json and the benchmark (times of
+     * its phases [s], sizes, memory [MB]), by name.
+     */
+    virtual std::map<std::string, double>
+    statistics() const
+    {
+      return {};
+    }
+  };
+
+
+
+  /**
+   * Today's path, as in step-41: each iteration copies C and d, condenses
+   * the Gamma_u/Gamma_o lines and the active rows into them, factorises
+   * with UMFPACK and solves. Its cost is (iterations x one factorisation).
+   */
+  class FullContactSystem : public ContactSystem
+  {
+  public:
+    /**
+     * @p matrix's pattern must hold every condensed system
+     * (ActiveSetSolver::make_sparsity_pattern).
+     */
+    FullContactSystem(const SparseMatrix<double>      &matrix,
+                      const AffineConstraints<double> &base,
+                      const std::vector<ContactPair>  &pairs);
+
+    /** Keeps a reference to @p rhs. */
+    void
+    set_rhs(const Vector<double> &rhs) override;
+
+    void
+    solve(const std::vector<bool> &active,
+          std::vector<double>     &excess,
+          std::vector<double>     &lambda) override;
+
+    double
+    displacement_scale() const override;
+
+    void
+    solution(Vector<double> &x) override;
+
+  private:
+    const SparseMatrix<double>      &matrix;
+    const Vector<double>            *rhs = nullptr;
+    const AffineConstraints<double> &base;
+    const std::vector<ContactPair>  &pairs;
+    SparseMatrix<double>             system_matrix;
+    Vector<double>                   system_rhs;
+    Vector<double>                   x;
+  };
+
+
+
+  /**
+   * The condensed path: one sparse Cholesky factorisation per mesh, with
+   * the contact unknowns c (every free dof of every contact row) ordered
+   * last, gives the Schur complement S = C_cc - C_ci C_ii^-1 C_ic of the
+   * interface from the trailing block of the factor; the active-set loop
+   * then runs on the dense k x k problem S x_c = f (k = number of contact
+   * unknowns, a few thousand at most in 2D), and one back substitution
+   * recovers the interior. A further load case on the same mesh costs one
+   * forward and one back substitution (set_rhs()).
+   *
+   * CHOLMOD factorises (supernodal, BLAS); METIS orders the interior.
+   * Neither library takes a Schur complement of a given set of unknowns
+   * from a factor, so the extraction and the dense active-set algebra are
+   * written here. A body held only by contact makes C singular but leaves
+   * C_ii regular: the factorised matrix is C + alpha I_c (the shift only
+   * touches the trailing block, L_cc L_cc^T = S + alpha I_c), and S is
+   * recovered by subtracting alpha.
+   */
+  class CondensedContactSystem : public ContactSystem
+  {
+  public:
+    /**
+     * Order, analyse and factorise C under @p base (closed); throws
+     * ExcNotPositiveDefinite if C_ii is singular (a body that neither the
+     * boundary conditions nor its contact unknowns can hold).
+     * @p order: a fill-reducing ordering of all dofs computed by the caller
+     * (the contact unknowns are moved to its end); empty: METIS on the
+     * interior here.
+     */
+    CondensedContactSystem(const SparseMatrix<double>      &matrix,
+                           const AffineConstraints<double> &base,
+                           const std::vector<ContactPair>  &pairs,
+                           const std::vector<int>          &order = {});
+    ~CondensedContactSystem() override;
+
+    /**
+     * A load case: condense d onto the contact unknowns (one forward
+     * substitution); must be called before solve().
+     */
+    void
+    set_rhs(const Vector<double> &rhs) override;
+
+    void
+    solve(const std::vector<bool> &active,
+          std::vector<double>     &excess,
+          std::vector<double>     &lambda) override;
+
+    double
+    displacement_scale() const override;
+
+    /** One back substitution. */
+    void
+    solution(Vector<double> &x) override;
+
+    /** Number of contact unknowns k. */
+    unsigned int
+    n_contact_unknowns() const;
+
+    /** Wall times [s] of the set-up phases (statistics()). */
+    struct Timings
+    {
+      double ordering      = 0;
+      double factorisation = 0;
+      double schur         = 0;
+      /** S~ = S + rho B^T B, its factor, W and G (multiplier loop). */
+      double loop_setup   = 0;
+      double condensation = 0;
+      double dense        = 0;
+      double expansion    = 0;
+    };
+
+    /**
+     * Memory [MB] of the sparse factor (values and row indices) and of the
+     * dense matrices (L_cc, S~'s factor, W, G), for the benchmark.
+     */
+    std::pair<double, double>
+    memory_MB() const;
+
+    std::map<std::string, double>
+    statistics() const override;
+
+  private:
+    class Implementation;
+    std::unique_ptr<Implementation> implementation;
+  };
+
+
+
+  /**
+   * The sparse path: step-41's iteration (condense the active rows into C,
+   * factorise, solve), made as cheap as a sparse factor allows. The
+   * matrix's pattern holds the condensed system of every active set
+   * (ActiveSetSolver::make_sparsity_pattern), so one METIS ordering and one
+   * CHOLMOD symbolic analysis serve every iteration and load case of a
+   * mesh; an iteration costs one numeric (supernodal) factorisation, and a
+   * solve with the active set of the previous one (a further load case, a
+   * repeated set) costs two triangular solves. Memory is that of the
+   * sparse factor: no dense interface matrices, so it scales where the
+   * condensed path does not (long contact zones, adaptive meshes).
+   */
+  class SparseContactSystem : public ContactSystem
+  {
+  public:
+    /**
+     * Order (METIS) and analyse (no factorisation yet).
+     */
+    SparseContactSystem(const SparseMatrix<double>      &matrix,
+                        const AffineConstraints<double> &base,
+                        const std::vector<ContactPair>  &pairs);
+    ~SparseContactSystem() override;
+
+    void
+    set_rhs(const Vector<double> &rhs) override;
+
+    void
+    solve(const std::vector<bool> &active,
+          std::vector<double>     &excess,
+          std::vector<double>     &lambda) override;
+
+    double
+    displacement_scale() const override;
+
+    void
+    solution(Vector<double> &x) override;
+
+    std::map<std::string, double>
+    statistics() const override;
+
+    /**
+     * The fill-reducing ordering of every dof (perm[new] = dof), which the
+     * condensed path reuses.
+     */
+    const std::vector<int> &
+    ordering() const;
+
+    /** Entries of the factor and flops of one factorisation. */
+    double
+    nnz_factor() const;
+    double
+    flops() const;
+
+  private:
+    class Implementation;
+    std::unique_ptr<Implementation> implementation;
+  };
+
+
+
+  /**
+   * How the active-set loop's linear algebra is done (Contact/Solver).
+   */
+  enum class SolverPath
+  {
+    automatic,
+    condensed,
+    sparse,
+    step41
+  };
+
+  /** "automatic", "condensed", "sparse", "step-41". */
+  std::string
+  solver_path_name(const SolverPath path);
+
+  /**
+   * The one factory of the solver seam. For SolverPath::automatic it
+   * estimates, before allocating, the time (flops) and peak memory of the
+   * condensed path (its dense interface arrays, k^3 and P^3 work) and of
+   * the sparse path (factor size and flops from CHOLMOD's symbolic
+   * analysis, times the expected iterations) and takes the cheaper that
+   * fits in the memory available to the process (MemAvailable, the cgroup
+   * limit, ulimit -v); a requested path that does not fit is switched, and
+   * if none fits the run is refused in one line naming the estimate and
+   * the limit. @p warm_start: the loop starts from a guess (a refined
+   * mesh, a further load case), so fewer iterations are expected. @p log
+   * gets one line saying which path and why; @p name receives the path.
+   */
+  std::unique_ptr<ContactSystem>
+  make_contact_system(const SolverPath                 requested,
+                      const SparseMatrix<double>      &matrix,
+                      const AffineConstraints<double> &base,
+                      const std::vector<ContactPair>  &pairs,
+                      const bool                       warm_start,
+                      std::ostream                    &log,
+                      std::string                     &name,
+                      std::map<std::string, double>   &figures);
+
+
+
+  /**
+   * One linear solve of C x = d with the Gamma_u/Gamma_o lines and the
+   * rows of the @p active pairs as equalities, by CHOLMOD with the same
+   * METIS ordering of vertices as CondensedContactSystem but no unknowns
+   * forced last: the fastest solve the project has, the reference of the
+   * benchmark. Returns the wall time of ordering, factorisation and solve.
+   */
+  double
+  reference_solve(const SparseMatrix<double>      &matrix,
+                  const Vector<double>            &rhs,
+                  const AffineConstraints<double> &base,
+                  const std::vector<ContactPair>  &pairs,
+                  const std::vector<bool>         &active,
+                  Vector<double>                  &x);
+} // namespace knee_contact
+
+#endif

@@ -1,0 +1,419 @@
+#include <knee_contact/contact/contact.h>
+#include <knee_contact/contact/contact_sides.h>
+#include <knee_contact/core/input.h>
+
+#include <deal.II/lac/vector.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <set>
+
+namespace knee_contact
+{
+  std::string
+  csv_file_name(const std::string &interface_name)
+  {
+    std::string name = interface_name;
+    std::replace_if(
+      name.begin(),
+      name.end(),
+      [](const char c) {
+        return !std::isalnum(static_cast<unsigned char>(c)) && c != '-';
+      },
+      '_');
+    return "contact_" + name + ".csv";
+  }
+
+
+
+  std::string
+  pairing_name(const Pairing pairing)
+  {
+    switch (pairing)
+      {
+        case Pairing::mortar:
+          return "mortar";
+        case Pairing::node_to_segment:
+          return "node-to-segment";
+        case Pairing::node_to_node:
+          return "node-to-node";
+      }
+    return "";
+  }
+
+
+
+  double
+  ContactPair::jump(const Vector<double> &x) const
+  {
+    double value = 0;
+    for (const auto &[dof, coefficient] : row)
+      value += coefficient * x(dof);
+    return value;
+  }
+
+
+
+  void
+  ContactInterfaces::declare_parameters(ParameterHandler  &prm,
+                                        const unsigned int n_interfaces)
+  {
+    prm.enter_subsection("Contact");
+    prm.declare_entry("Number of interfaces",
+                      "0",
+                      Patterns::Integer(0, 255),
+                      "How many subsections 'Interface 0', 'Interface 1', "
+                      "... follow (the seed's Gamma_c^kl).");
+    for (unsigned int i = 0; i < n_interfaces; ++i)
+      {
+        prm.enter_subsection("Interface " + std::to_string(i));
+        prm.declare_entry("Name",
+                          "interface " + std::to_string(i),
+                          Patterns::Anything(),
+                          "Name used in results and file names.");
+        prm.declare_entry("Slave boundary id",
+                          "0",
+                          Patterns::Integer(0, 254),
+                          "Boundary id of the side of body k whose vertices "
+                          "are paired (prefer the finer or softer side).");
+        prm.declare_entry("Master boundary id",
+                          "0",
+                          Patterns::Integer(0, 254),
+                          "Boundary id of the side of body l.");
+        prm.declare_entry(
+          "Pairing",
+          "mortar",
+          Patterns::Selection("mortar|node-to-segment|node-to-node"),
+          "mortar: dual mortar (segment-to-segment) conditions, one per "
+          "slave vertex, weighted by the biorthogonal multiplier basis; "
+          "exact contact pressure for the patch test on non-matching "
+          "meshes, either side slave. node-to-segment: each slave vertex is "
+          "paired with the point of the master side along its normal. "
+          "node-to-node: the seed's node pairs, every slave vertex must "
+          "coincide with a master vertex.");
+        prm.declare_entry("Maximum gap",
+                          "0",
+                          Patterns::Double(0),
+                          "Slave vertices farther than this from the master "
+                          "side [m] are not paired; 0: no limit.");
+        prm.leave_subsection();
+      }
+    prm.leave_subsection();
+  }
+
+
+
+  void
+  ContactInterfaces::parse_parameters(ParameterHandler  &prm,
+                                      const unsigned int n_interfaces)
+  {
+    prm.enter_subsection("Contact");
+    for (unsigned int i = 0; i < n_interfaces; ++i)
+      {
+        prm.enter_subsection("Interface " + std::to_string(i));
+        ContactInterface interface;
+        interface.name = prm.get("Name");
+        input::check_name(interface.name,
+                          "Contact/Interface " + std::to_string(i) + "/Name");
+        interface.slave_id =
+          static_cast<types::boundary_id>(prm.get_integer("Slave boundary id"));
+        interface.master_id = static_cast<types::boundary_id>(
+          prm.get_integer("Master boundary id"));
+        // The Selection pattern admits exactly the names pairing_name()
+        // gives.
+        for (const Pairing p :
+             {Pairing::mortar, Pairing::node_to_segment, Pairing::node_to_node})
+          if (prm.get("Pairing") == pairing_name(p))
+            interface.pairing = p;
+        interface.maximum_gap = prm.get_double("Maximum gap");
+        const std::string where =
+          "Contact/Interface " + std::to_string(i) + ": ";
+        AssertThrow(interface.slave_id != interface.master_id,
+                    ExcMessage(where +
+                               "slave and master boundary ids are "
+                               "both " +
+                               std::to_string(interface.slave_id)));
+        for (const auto &other : list)
+          AssertThrow(other.name != interface.name &&
+                        csv_file_name(other.name) !=
+                          csv_file_name(interface.name),
+                      ExcMessage(where + "the name '" + interface.name +
+                                 "' is (as a file name, " +
+                                 csv_file_name(interface.name) +
+                                 ") that of interface '" + other.name +
+                                 "' too"));
+        for (const auto &other : list)
+          AssertThrow(other.slave_id != interface.slave_id &&
+                        other.slave_id != interface.master_id &&
+                        other.master_id != interface.slave_id &&
+                        other.master_id != interface.master_id,
+                      ExcMessage(where +
+                                 "shares a boundary id with "
+                                 "interface '" +
+                                 other.name + "'"));
+        list.push_back(interface);
+        prm.leave_subsection();
+      }
+    prm.leave_subsection();
+  }
+
+
+
+  void
+  ContactInterfaces::check_mesh(const Triangulation<2>          &triangulation,
+                                const std::vector<unsigned int> &body_ids) const
+  {
+    for (unsigned int i = 0; i < list.size(); ++i)
+      {
+        std::set<unsigned int> slave_bodies, master_bodies;
+        for (const auto &cell : triangulation.active_cell_iterators())
+          for (const auto &face : cell->face_iterators())
+            if (face->at_boundary())
+              {
+                if (face->boundary_id() == list[i].slave_id)
+                  slave_bodies.insert(body_ids[cell->active_cell_index()]);
+                if (face->boundary_id() == list[i].master_id)
+                  master_bodies.insert(body_ids[cell->active_cell_index()]);
+              }
+        const std::string where = "Contact/Interface " + std::to_string(i) +
+                                  " ('" + list[i].name + "'): ";
+        AssertThrow(!slave_bodies.empty(),
+                    ExcMessage(where + "the mesh has no boundary id " +
+                               std::to_string(list[i].slave_id)));
+        AssertThrow(!master_bodies.empty(),
+                    ExcMessage(where + "the mesh has no boundary id " +
+                               std::to_string(list[i].master_id)));
+        for (const unsigned int b : slave_bodies)
+          AssertThrow(master_bodies.count(b) == 0,
+                      ExcMessage(where +
+                                 "slave and master sides both lie "
+                                 "on body " +
+                                 std::to_string(b) +
+                                 " (self contact is not supported; bodies "
+                                 "sharing vertices are bonded)"));
+      }
+  }
+
+
+
+  namespace
+  {
+    // Outward normal of a boundary face of a cell, with the face's length
+    // as its norm (so that summing over a vertex's faces weights by length).
+    Tensor<1, 2>
+    outward_normal(const DoFHandler<2>::active_cell_iterator &cell,
+                   const unsigned int                         f)
+    {
+      const auto   face = cell->face(f);
+      Tensor<1, 2> t    = face->vertex(1) - face->vertex(0);
+      Tensor<1, 2> n({t[1], -t[0]});
+      if (n * (face->center() - cell->center()) < 0)
+        n = -n;
+      return n;
+    }
+
+    // Substitute the Gamma_u/Gamma_o lines into a row: x_i = sum_j c_ij x_j
+    // + g_i for every constrained i, so the row acts on free dofs only.
+    void
+    reduce_row(ContactPair &pair, const AffineConstraints<double> &constraints)
+    {
+      std::map<types::global_dof_index, double> reduced;
+      double                                    rhs = pair.gap;
+      for (const auto &[dof, a] : pair.row)
+        if (constraints.is_constrained(dof))
+          {
+            rhs -= a * constraints.get_inhomogeneity(dof);
+            for (const auto &[j, c] : *constraints.get_constraint_entries(dof))
+              reduced[j] += a * c;
+          }
+        else
+          reduced[dof] += a;
+      double scale = 0;
+      for (const auto &entry : reduced)
+        scale = std::max(scale, std::abs(entry.second));
+      pair.reduced_row.clear();
+      for (const auto &entry : reduced)
+        if (std::abs(entry.second) > 1e-12 * scale)
+          pair.reduced_row.push_back(entry);
+      pair.reduced_gap = rhs;
+    }
+
+    ContactSides
+    collect_sides(const DoFHandler<2>    &dof_handler,
+                  const ContactInterface &interface)
+    {
+      ContactSides sides;
+      sides.min_length = std::numeric_limits<double>::max();
+      for (const auto &cell : dof_handler.active_cell_iterators())
+        for (const unsigned int f : cell->face_indices())
+          if (cell->face(f)->at_boundary())
+            {
+              const auto         face = cell->face(f);
+              const Tensor<1, 2> n    = outward_normal(cell, f);
+              ContactSides::Face side;
+              for (unsigned int v = 0; v < 2; ++v)
+                {
+                  side.vertex_keys[v] = face->vertex_index(v);
+                  side.vertices[v]    = face->vertex(v);
+                  side.dofs[v]        = {{face->vertex_dof_index(v, 0),
+                                          face->vertex_dof_index(v, 1)}};
+                }
+              side.normal = n / n.norm();
+              if (face->boundary_id() == interface.slave_id)
+                {
+                  for (unsigned int v = 0; v < 2; ++v)
+                    {
+                      auto &s    = sides.slaves[side.vertex_keys[v]];
+                      s.position = side.vertices[v];
+                      s.normal += n; // length-weighted: |n| = face length
+                      s.length += 0.5 * n.norm();
+                      s.dofs = side.dofs[v];
+                    }
+                  sides.min_length = std::min(sides.min_length, n.norm());
+                  sides.slave_faces.push_back(side);
+                }
+              else if (face->boundary_id() == interface.master_id)
+                sides.master_faces.push_back(side);
+            }
+      return sides;
+    }
+  } // namespace
+
+
+
+  std::vector<ContactPair>
+  node_to_segment_rows(const ContactSides     &sides,
+                       const ContactInterface &interface,
+                       const unsigned int      interface_index,
+                       const std::string      &where)
+  {
+    std::vector<ContactPair> pairs;
+    for (const auto &[vertex, slave] : sides.slaves)
+      {
+        const Tensor<1, 2> n   = slave.unit_normal();
+        const double       tol = 1e-8 * sides.min_length;
+        // Node-to-segment: x + s n = p0 + xi (p1 - p0), the closest
+        // master face facing the slave (n_master . n < 0) along n.
+        double best_s = std::numeric_limits<double>::max(), best_xi = 0;
+        const ContactSides::Face *best = nullptr;
+        for (const ContactSides::Face &m : sides.master_faces)
+          {
+            if (m.normal * n >= 0)
+              continue;
+            const Tensor<1, 2> t   = m.vertices[1] - m.vertices[0];
+            const Tensor<1, 2> r   = m.vertices[0] - slave.position;
+            const double       det = -n[0] * t[1] + n[1] * t[0];
+            if (std::abs(det) < 1e-12 * t.norm())
+              continue;
+            const double s  = (-r[0] * t[1] + r[1] * t[0]) / det;
+            const double xi = (n[0] * r[1] - n[1] * r[0]) / det;
+            if (xi < -1e-10 || xi > 1 + 1e-10 || s < -2 * slave.length)
+              continue;
+            if (std::abs(s) < std::abs(best_s))
+              {
+                best_s  = s;
+                best_xi = std::clamp(xi, 0., 1.);
+                best    = &m;
+              }
+          }
+        if (best != nullptr && std::abs(best_s) <= tol)
+          best_s = 0;
+        if (best != nullptr && (best_xi < 1e-8 || best_xi > 1 - 1e-8) &&
+            best_s == 0)
+          best_xi = std::round(best_xi);
+        if (interface.pairing == Pairing::node_to_node)
+          AssertThrow(best != nullptr && best_s == 0 &&
+                        (best_xi == 0 || best_xi == 1),
+                      ExcMessage(where +
+                                 "node-to-node pairing: slave "
+                                 "vertex at (" +
+                                 std::to_string(slave.position[0]) + ", " +
+                                 std::to_string(slave.position[1]) +
+                                 ") has no coincident master vertex"));
+        if (best == nullptr ||
+            (interface.maximum_gap > 0 && best_s > interface.maximum_gap))
+          continue;
+        AssertThrow(best_s >= -tol,
+                    ExcMessage(where + "slave vertex at (" +
+                               std::to_string(slave.position[0]) + ", " +
+                               std::to_string(slave.position[1]) +
+                               ") penetrates the master side by " +
+                               std::to_string(-best_s) +
+                               " m; initial overlap is not supported"));
+
+        ContactPair pair;
+        pair.interface    = interface_index;
+        pair.position     = slave.position;
+        pair.normal       = n;
+        pair.gap          = best_s;
+        pair.master_point = slave.position + best_s * n;
+        pair.length       = slave.length;
+        pair.slave_dofs   = slave.dofs;
+        for (unsigned int d = 0; d < 2; ++d)
+          pair.row.emplace_back(slave.dofs[d], n[d]);
+        for (unsigned int v = 0; v < 2; ++v)
+          {
+            const double weight = v == 0 ? 1 - best_xi : best_xi;
+            if (weight != 0)
+              for (unsigned int d = 0; d < 2; ++d)
+                pair.row.emplace_back(best->dofs[v][d], -weight * n[d]);
+          }
+        pairs.push_back(pair);
+      }
+    return pairs;
+  }
+
+
+
+  std::vector<ContactPair>
+  ContactInterfaces::make_pairs(
+    const DoFHandler<2>             &dof_handler,
+    const AffineConstraints<double> &constraints) const
+  {
+    std::vector<ContactPair>          pairs;
+    std::set<types::global_dof_index> eliminated;
+    for (unsigned int i = 0; i < list.size(); ++i)
+      {
+        const ContactInterface &interface = list[i];
+        const ContactSides      sides = collect_sides(dof_handler, interface);
+        const std::string where = "Contact/Interface " + std::to_string(i) +
+                                  " ('" + interface.name + "'): ";
+        AssertThrow(!sides.slaves.empty() && !sides.master_faces.empty(),
+                    ExcMessage(where + "a side has no faces"));
+        std::vector<ContactPair> rows =
+          interface.pairing == Pairing::mortar
+            ? mortar_rows(sides, interface, i, where)
+            : node_to_segment_rows(sides, interface, i, where);
+
+        for (ContactPair &pair : rows)
+          {
+            reduce_row(pair, constraints);
+            // Eliminate the free slave component with the largest |n|,
+            // else the largest free other component.
+            for (const bool slave_side : {true, false})
+              {
+                double largest = 0;
+                for (const auto &[dof, a] : pair.reduced_row)
+                  {
+                    const bool on_slave =
+                      dof == pair.slave_dofs[0] || dof == pair.slave_dofs[1];
+                    if (on_slave == slave_side && !eliminated.count(dof) &&
+                        std::abs(a) > largest + 1e-12)
+                      {
+                        largest         = std::abs(a);
+                        pair.eliminated = dof;
+                      }
+                  }
+                if (pair.eliminated != numbers::invalid_dof_index)
+                  break;
+              }
+            if (pair.eliminated != numbers::invalid_dof_index)
+              eliminated.insert(pair.eliminated);
+            pairs.push_back(std::move(pair));
+          }
+      }
+    return pairs;
+  }
+} // namespace knee_contact

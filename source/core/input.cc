@@ -1,0 +1,278 @@
+#include <knee_contact/core/input.h>
+
+#include <deal.II/lac/vector.h>
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+namespace knee_contact
+{
+  namespace input
+  {
+    std::string
+    resolve_path(const std::string &path, const std::string &scene_file)
+    {
+      const std::filesystem::path p(path);
+      if (p.is_absolute() || path.empty())
+        return path;
+      // The scene's own folder, through symbolic links (build/knee.prm links
+      // to prm/knee.prm, whose mesh lies beside it).
+      return (std::filesystem::weakly_canonical(scene_file).parent_path() / p)
+        .lexically_normal()
+        .string();
+    }
+
+
+
+    std::vector<std::string>
+    split(const std::string &text, const char separator)
+    {
+      std::vector<std::string> parts;
+      std::string              part;
+      std::istringstream       in(text);
+      while (std::getline(in, part, separator))
+        parts.push_back(Utilities::trim(part));
+      if (!text.empty() && text.back() == separator)
+        parts.emplace_back();
+      return parts;
+    }
+
+
+
+    std::vector<std::pair<std::string, std::string>>
+    split_named(const std::string &text,
+                const std::string &parameter,
+                const std::string &form)
+    {
+      std::vector<std::pair<std::string, std::string>> entries;
+      for (const auto &entry : split(text, ';'))
+        if (!entry.empty())
+          {
+            const auto name_value = split(entry, ':');
+            AssertThrow(name_value.size() == 2 && !name_value[0].empty(),
+                        ExcMessage(parameter + ": '" + entry +
+                                   "' is not of the form '" + form + "'"));
+            entries.emplace_back(name_value[0], name_value[1]);
+          }
+      return entries;
+    }
+
+
+
+    Point<2>
+    to_point(const std::string &text, const std::string &parameter)
+    {
+      const auto xy = split(text, ',');
+      AssertThrow(xy.size() == 2,
+                  ExcMessage(parameter + ": '" + text +
+                             "' is not a point 'x, y'"));
+      return Point<2>(to_double(xy[0], parameter), to_double(xy[1], parameter));
+    }
+
+
+
+    double
+    to_double(const std::string &text, const std::string &parameter)
+    {
+      double      value = 0;
+      std::size_t end   = 0;
+      try
+        {
+          value = std::stod(text, &end);
+        }
+      catch (...)
+        {
+          end = 0;
+        }
+      AssertThrow(end != 0 && Utilities::trim(text.substr(end)).empty() &&
+                    std::isfinite(value),
+                  ExcMessage("parameter '" + parameter + "': '" + text +
+                             "' is not a finite number"));
+      return value;
+    }
+
+
+
+    std::unique_ptr<FunctionParser<2>>
+    parse_expression(const std::string &expression,
+                     const unsigned int n_components,
+                     const std::string &parameter,
+                     const std::string &constants,
+                     const bool         load)
+    {
+      const auto parts = split(expression, ';');
+      AssertThrow(parts.size() == n_components,
+                  ExcMessage("parameter '" + parameter + "': expected " +
+                             std::to_string(n_components) +
+                             " component(s) separated by ';', got '" +
+                             expression + "'"));
+      std::map<std::string, double> constant_map = {{"pi", numbers::PI}};
+      for (const auto &c : split(constants, ','))
+        if (!c.empty())
+          {
+            const auto name_value = split(c, '=');
+            AssertThrow(name_value.size() == 2 && !name_value[0].empty(),
+                        ExcMessage("parameter '" + parameter + "': constant '" +
+                                   c + "' is not of the form name=value"));
+            constant_map[name_value[0]] =
+              to_double(name_value[1], parameter + " constants");
+          }
+
+      // The finite difference step only matters for gradients of reference
+      // solutions; a fourth order formula with h = 1e-4 keeps their error
+      // near 1e-13 for smooth fields.
+      auto function =
+        std::make_unique<FunctionParser<2>>(n_components, 0., 1e-4);
+      function->set_formula(AutoDerivativeFunction<2>::FourthOrder);
+      // deal.II prints muparser's complaint to std::cerr before it throws;
+      // silence that, the message below says it in one line.
+      std::ostringstream    muparser_output;
+      std::streambuf *const cerr_buffer =
+        std::cerr.rdbuf(muparser_output.rdbuf());
+      Vector<double> values(n_components);
+      try
+        {
+          function->initialize(load ? "x,y,t" : "x,y",
+                               parts,
+                               constant_map,
+                               load);
+          function->vector_value(Point<2>(0.123456789, 0.234567891), values);
+          std::cerr.rdbuf(cerr_buffer);
+        }
+      catch (const std::exception &exc)
+        {
+          std::cerr.rdbuf(cerr_buffer);
+          const std::string what = one_line(exc.what());
+          AssertThrow(false,
+                      ExcMessage(
+                        "parameter '" + parameter +
+                        "': cannot evaluate expression '" + expression + "' (" +
+                        what + ")" +
+                        (!load && what.find("\"t\"") != std::string::npos
+                           ? "; the load parameter t may only appear in "
+                             "traction, pressure, body force and "
+                             "exact-solution expressions"
+                           : "")));
+        }
+      // A value that is not finite at a generic point is a mistake (1/0,
+      // log(0)), not a singularity the scene means.
+      for (unsigned int c = 0; c < n_components; ++c)
+        AssertThrow(std::isfinite(values(c)),
+                    ExcMessage("parameter '" + parameter + "': '" + expression +
+                               "' is not finite (inf or nan) at (x, y) = "
+                               "(0.123456789, 0.234567891)"));
+      return function;
+    }
+
+
+
+    double
+    evaluate_constant(const std::string &expression,
+                      const std::string &parameter)
+    {
+      const auto   function = parse_expression(expression, 1, parameter);
+      const double value    = function->value(Point<2>());
+      AssertThrow(std::isfinite(value),
+                  ExcMessage("parameter '" + parameter + "': '" + expression +
+                             "' is not finite"));
+      return value;
+    }
+
+
+
+    std::string
+    one_line(const std::string &text)
+    {
+      // deal.II's ExceptionBase::what() holds "Additional information:"
+      // followed by the message, then a stack trace; keep only the message.
+      std::string message = text;
+      const auto  info    = message.find("Additional information:");
+      if (info != std::string::npos)
+        message = message.substr(info + 23);
+      const auto trace = message.find("Stacktrace:");
+      if (trace != std::string::npos)
+        message = message.substr(0, trace);
+      std::string line;
+      bool        space = false;
+      for (const char c : message)
+        if (c == '\n' || c == '\t' || c == ' ' || c == '\r')
+          space = !line.empty();
+        else
+          {
+            if (space)
+              line += ' ';
+            // Control characters (from a binary file) would garble the
+            // terminal.
+            line += (static_cast<unsigned char>(c) < 32 || c == 127) ? '?' : c;
+            space = false;
+          }
+      // Strip a line of dashes deal.II adds around its messages.
+      while (!line.empty() && line.back() == '-')
+        line.pop_back();
+      return cap(Utilities::trim(line));
+    }
+
+
+
+    std::string
+    cap(const std::string &line)
+    {
+      // A value echoed in quotes ('...' or ParameterHandler's <...>) keeps
+      // its first 200 bytes, cut at a character boundary.
+      const auto cut = [](const std::string &text, std::size_t n) {
+        while (n > 0 && n < text.size() &&
+               (static_cast<unsigned char>(text[n]) & 0xC0) == 0x80)
+          --n;
+        return text.substr(0, n);
+      };
+      std::string result;
+      for (std::size_t i = 0; i < line.size();)
+        {
+          const char open  = line[i];
+          const char close = open == '\'' ? '\'' : (open == '<' ? '>' : '\0');
+          const std::size_t end =
+            close ? line.find(close, i + 1) : std::string::npos;
+          if (end != std::string::npos && end - i - 1 > 200)
+            {
+              const std::string value = line.substr(i + 1, end - i - 1);
+              result += open + cut(value, 200) + "... (" +
+                        std::to_string(value.size()) + " characters)" + close;
+              i = end + 1;
+            }
+          else
+            result += line[i++];
+        }
+      return result.size() > 1000 ? cut(result, 1000) + "..." : result;
+    }
+
+
+
+    void
+    check_name(const std::string &name, const std::string &parameter)
+    {
+      AssertThrow(!name.empty() && name.size() <= 100,
+                  ExcMessage(parameter + ": a name needs 1 to 100 bytes"));
+      for (std::size_t i = 0; i < name.size(); ++i)
+        AssertThrow(static_cast<unsigned char>(name[i]) >= 32 && name[i] != 127,
+                    ExcMessage(parameter + ": '" + one_line(name) +
+                               "' holds a control character (byte " +
+                               std::to_string(i + 1) + ")"));
+      // summary.json must stay valid JSON: nlohmann-json's encoder checks
+      // UTF-8 strictly (overlong forms and surrogates too).
+      try
+        {
+          (void)nlohmann::json(name).dump();
+        }
+      catch (const nlohmann::json::exception &)
+        {
+          AssertThrow(false,
+                      ExcMessage(parameter + ": '" + one_line(name) +
+                                 "' is not valid UTF-8 text"));
+        }
+    }
+  } // namespace input
+} // namespace knee_contact

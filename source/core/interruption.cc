@@ -1,0 +1,163 @@
+#include <knee_contact/core/interruption.h>
+
+#include <dirent.h>
+#include <fcntl.h>
+#include <sys/syscall.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <csignal>
+#include <cstring>
+
+namespace knee_contact
+{
+  namespace interruption
+  {
+    namespace
+    {
+      // Paths live in fixed buffers: the handler must not allocate. A slot
+      // is in use while its first character is not '\0'.
+      constexpr unsigned int max_paths  = 8;
+      constexpr std::size_t  max_length = 4096;
+      char                   folders[max_paths][max_length];
+      char                   files[max_paths][max_length];
+      std::atomic<pid_t>     child{0};
+
+      void
+      put(char (&slots)[max_paths][max_length], const std::string &path)
+      {
+        if (path.empty() || path.size() + 1 > max_length)
+          return;
+        for (auto &slot : slots)
+          if (slot[0] == '\0')
+            {
+              // The first character last: the handler never sees half a
+              // path.
+              std::memcpy(slot + 1, path.c_str() + 1, path.size());
+              std::atomic_signal_fence(std::memory_order_seq_cst);
+              slot[0] = path[0];
+              return;
+            }
+      }
+
+      void
+      take(char (&slots)[max_paths][max_length], const std::string &path)
+      {
+        for (auto &slot : slots)
+          if (path == slot)
+            slot[0] = '\0';
+      }
+
+      // Remove the entries of @p folder and the folder itself, with system
+      // calls only (readdir may allocate; getdents64 does not).
+      void
+      remove_folder(const char *folder)
+      {
+        const int fd = open(folder, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+        if (fd >= 0)
+          {
+            alignas(8) char buffer[8192];
+            for (;;)
+              {
+                const long n =
+                  syscall(SYS_getdents64, fd, buffer, sizeof(buffer));
+                if (n <= 0)
+                  break;
+                for (long offset = 0; offset < n;)
+                  {
+                    // struct linux_dirent64: ino (8), off (8), reclen (2),
+                    // type (1), name.
+                    unsigned short length;
+                    std::memcpy(&length, buffer + offset + 16, sizeof(length));
+                    const char *name = buffer + offset + 19;
+                    if (std::strcmp(name, ".") != 0 &&
+                        std::strcmp(name, "..") != 0)
+                      if (unlinkat(fd, name, 0) != 0)
+                        unlinkat(fd, name, AT_REMOVEDIR);
+                    offset += length;
+                  }
+              }
+            close(fd);
+          }
+        rmdir(folder);
+      }
+
+      void
+      handle(const int signal)
+      {
+        const pid_t group = child.load();
+        if (group > 0)
+          {
+            kill(-group, SIGKILL);
+            while (waitpid(group, nullptr, 0) < 0 && errno == EINTR)
+              ;
+          }
+        for (const auto &folder : folders)
+          if (folder[0] != '\0')
+            remove_folder(folder);
+        for (const auto &file : files)
+          if (file[0] != '\0')
+            unlink(file);
+        const char message[] = "knee_contact: interrupted by a signal; the "
+                               "output folder is unchanged\n";
+        [[maybe_unused]] const auto written =
+          write(STDERR_FILENO, message, sizeof(message) - 1);
+        _exit(128 + signal);
+      }
+    } // namespace
+
+
+
+    void
+    install()
+    {
+      struct sigaction action;
+      std::memset(&action, 0, sizeof(action));
+      action.sa_handler = handle;
+      sigfillset(&action.sa_mask);
+      for (const int signal : {SIGINT, SIGTERM, SIGHUP})
+        sigaction(signal, &action, nullptr);
+    }
+
+
+
+    void
+    register_folder(const std::string &folder)
+    {
+      put(folders, folder);
+    }
+
+
+
+    void
+    unregister_folder(const std::string &folder)
+    {
+      take(folders, folder);
+    }
+
+
+
+    void
+    register_file(const std::string &file)
+    {
+      put(files, file);
+    }
+
+
+
+    void
+    unregister_file(const std::string &file)
+    {
+      take(files, file);
+    }
+
+
+
+    void
+    set_child(const pid_t process_group)
+    {
+      child.store(process_group);
+    }
+  } // namespace interruption
+} // namespace knee_contact

@@ -1,0 +1,576 @@
+#include <knee_contact/core/external_program.h>
+#include <knee_contact/mesh/gmsh_input.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <unordered_set>
+
+namespace knee_contact
+{
+  namespace gmsh_input
+  {
+    namespace
+    {
+      bool
+      is_number(const std::string &text)
+      {
+        std::size_t end = 0;
+        try
+          {
+            const double value = std::stod(text, &end);
+            return end == text.size() && std::isfinite(value);
+          }
+        catch (...)
+          {
+            return false;
+          }
+      }
+
+
+
+      // A .msh read line by line, with the line number for messages.
+      class MshReader
+      {
+      public:
+        explicit MshReader(const std::string &file)
+          : file(file)
+          , in(file)
+        {
+          std::error_code code;
+          size = std::filesystem::file_size(file, code);
+          if (!in || code)
+            fail("cannot open the file");
+        }
+
+        [[noreturn]] void
+        fail(const std::string &what) const
+        {
+          throw std::runtime_error("Mesh/File: '" + file + "' line " +
+                                   std::to_string(line_number) + ": " + what);
+        }
+
+        // The next line, split at white space; false at the end.
+        bool
+        next(std::vector<std::string> &tokens)
+        {
+          std::string line;
+          if (!std::getline(in, line))
+            return false;
+          ++line_number;
+          tokens.clear();
+          std::istringstream words(line);
+          for (std::string w; words >> w;)
+            tokens.push_back(w);
+          return true;
+        }
+
+        std::vector<std::string>
+        expect(const std::size_t  n_min,
+               const std::size_t  n_max,
+               const std::string &what)
+        {
+          std::vector<std::string> tokens;
+          if (!next(tokens))
+            fail("the file ends before " + what + " (truncated?)");
+          if (tokens.size() < n_min || tokens.size() > n_max)
+            fail(
+              "expected " + what + ", found " + std::to_string(tokens.size()) +
+              " fields" +
+              (n_min == n_max ? " instead of " + std::to_string(n_min) : ""));
+          return tokens;
+        }
+
+        // A count; each entry takes at least a few bytes, so a count
+        // larger than the file can hold is refused before anyone allocates.
+        unsigned long long
+        count(const std::string &token, const std::string &what) const
+        {
+          if (token.empty() || token.size() > 19 ||
+              token.find_first_not_of("0123456789") != std::string::npos)
+            fail(what + " '" + token + "' is not a non-negative integer");
+          const unsigned long long n = std::stoull(token);
+          if (n > size / 2 + 1)
+            fail(what + " " + token + " is more than the file's " +
+                 std::to_string(size) + " bytes can hold");
+          return n;
+        }
+
+        long long
+        tag(const std::string &token, const std::string &what) const
+        {
+          if (token.empty() || token.size() > 18 ||
+              token.find_first_not_of("-0123456789") != std::string::npos)
+            fail(what + " '" + token + "' is not an integer");
+          return std::stoll(token);
+        }
+
+        // A node tag of $Nodes, which must not repeat.
+        void
+        add_node(std::unordered_set<long long> &nodes,
+                 const std::string             &token) const
+        {
+          if (!nodes.insert(tag(token, "node tag")).second)
+            fail("node tag " + token + " appears twice");
+        }
+
+        // The node tags t[first], ... of element t[0]: each must be in
+        // $Nodes.
+        void
+        check_element_nodes(const std::unordered_set<long long> &nodes,
+                            const std::vector<std::string>      &t,
+                            const std::size_t                    first) const
+        {
+          for (std::size_t k = first; k < t.size(); ++k)
+            if (nodes.count(tag(t[k], "node tag")) == 0)
+              fail("element " + t[0] + " refers to node " + t[k] +
+                   ", which is not in $Nodes");
+        }
+
+        void
+        coordinate(const std::string &token) const
+        {
+          if (!is_number(token))
+            fail("coordinate '" + token + "' is not a finite number");
+        }
+
+        void
+        end_of(const std::string &section)
+        {
+          std::vector<std::string> tokens;
+          if (!next(tokens) || tokens.size() != 1 ||
+              tokens[0] != "$End" + section)
+            fail("expected $End" + section +
+                 " (a count does not match the entries, or the header's "
+                 "version does not match the body)");
+        }
+
+        void
+        skip_section(const std::string &section)
+        {
+          std::vector<std::string> tokens;
+          while (next(tokens))
+            if (tokens.size() == 1 && tokens[0] == "$End" + section)
+              return;
+          fail("no $End" + section + " (truncated?)");
+        }
+
+        const std::string file;
+
+      private:
+        std::ifstream      in;
+        unsigned long long size        = 0;
+        unsigned long      line_number = 0;
+      };
+
+
+
+      // Nodes of the element types deal.II reads in 2D (linear ones).
+      unsigned int
+      n_nodes(const long long type, const MshReader &reader)
+      {
+        switch (type)
+          {
+            case 15:
+              return 1;
+            case 1:
+              return 2;
+            case 2:
+              return 3;
+            case 3:
+              return 4;
+            default:
+              reader.fail("element type " + std::to_string(type) +
+                          " is not supported (points 15, lines 1, triangles "
+                          "2, quadrilaterals 3; linear elements only)");
+          }
+      }
+
+
+
+      void
+      check_msh2(MshReader &reader)
+      {
+        std::unordered_set<long long> nodes;
+        bool                          have_nodes = false, have_elements = false;
+        std::vector<std::string>      t;
+        while (reader.next(t))
+          {
+            if (t.empty())
+              continue;
+            if (t[0] == "$Nodes")
+              {
+                const auto n =
+                  reader.count(reader.expect(1, 1, "the node count")[0],
+                               "node count");
+                for (unsigned long long i = 0; i < n; ++i)
+                  {
+                    t = reader.expect(4, 4, "a node 'tag x y z'");
+                    reader.add_node(nodes, t[0]);
+                    for (unsigned int d = 1; d < 4; ++d)
+                      reader.coordinate(t[d]);
+                  }
+                reader.end_of("Nodes");
+                have_nodes = true;
+              }
+            else if (t[0] == "$Elements")
+              {
+                if (!have_nodes)
+                  reader.fail("$Elements before $Nodes");
+                const auto n =
+                  reader.count(reader.expect(1, 1, "the element count")[0],
+                               "element count");
+                for (unsigned long long i = 0; i < n; ++i)
+                  {
+                    t = reader.expect(4, 64, "an element");
+                    const unsigned int n_v =
+                      n_nodes(reader.tag(t[1], "element type"), reader);
+                    const long long n_tags = reader.tag(t[2], "tag count");
+                    if (n_tags < 0 ||
+                        t.size() != 3 + static_cast<std::size_t>(n_tags) + n_v)
+                      reader.fail("element " + t[0] + " has " +
+                                  std::to_string(t.size()) +
+                                  " fields, not 3 + tags + nodes");
+                    const std::size_t first_node =
+                      3 + static_cast<std::size_t>(n_tags);
+                    for (std::size_t k = 3; k < first_node; ++k)
+                      if (reader.tag(t[k], "element tag") < 0)
+                        reader.fail("element " + t[0] + " has a negative tag");
+                    if ((n_v == 3 || n_v == 4) && (n_tags == 0 || t[3] == "0"))
+                      reader.fail("cell " + t[0] +
+                                  " has no physical group, so no material id "
+                                  "(give every surface a Physical Surface)");
+                    reader.check_element_nodes(nodes, t, first_node);
+                  }
+                reader.end_of("Elements");
+                have_elements = true;
+              }
+            else if (t[0].size() > 1 && t[0][0] == '$')
+              reader.skip_section(t[0].substr(1));
+          }
+        if (!have_nodes || !have_elements)
+          reader.fail("no $Nodes or no $Elements section (truncated?)");
+      }
+
+
+
+      void
+      check_msh4(MshReader &reader)
+      {
+        std::unordered_set<long long> nodes;
+        std::unordered_set<long long> unnamed_surfaces;
+        unsigned int                  n_named_surfaces = 0;
+        bool have_entities = false, have_nodes = false, have_elements = false;
+        std::vector<std::string> t;
+        while (reader.next(t))
+          {
+            if (t.empty())
+              continue;
+            if (t[0] == "$Entities")
+              {
+                t = reader.expect(4, 4, "'numPoints numCurves ...'");
+                for (unsigned int dim = 0; dim < 4; ++dim)
+                  {
+                    const auto n = reader.count(t[dim], "entity count");
+                    for (unsigned long long i = 0; i < n; ++i)
+                      {
+                        // point: tag x y z n_phys tags...; curves and
+                        // surfaces: tag box(6) n_phys tags... n_b tags...
+                        const auto e = reader.expect(dim == 0 ? 5 : 9,
+                                                     1u << 20,
+                                                     "an entity");
+                        const std::size_t p = dim == 0 ? 4 : 7;
+                        const auto        n_phys =
+                          reader.count(e[p], "physical tag count");
+                        if (e.size() < p + 1 + n_phys + (dim == 0 ? 0 : 1))
+                          reader.fail("entity " + e[0] +
+                                      " has fewer fields than its counts say");
+                        if (dim == 2 && n_phys == 0)
+                          unnamed_surfaces.insert(
+                            reader.tag(e[0], "entity tag"));
+                        if (dim == 2 && n_phys > 0)
+                          ++n_named_surfaces;
+                      }
+                  }
+                reader.end_of("Entities");
+                // Gmsh saves only the cells of physical groups once there
+                // are any: the cells of other surfaces would vanish.
+                if (n_named_surfaces > 0 && !unnamed_surfaces.empty())
+                  reader.fail(
+                    "surface " +
+                    std::to_string(*std::min_element(unnamed_surfaces.begin(),
+                                                     unnamed_surfaces.end())) +
+                    " has no physical group, so its cells would be "
+                    "dropped (give every surface a Physical "
+                    "Surface)");
+                have_entities = true;
+              }
+            else if (t[0] == "$Nodes")
+              {
+                t = reader.expect(4, 4, "'numEntityBlocks numNodes ...'");
+                const auto         n_blocks = reader.count(t[0], "block count");
+                const auto         n_total  = reader.count(t[1], "node count");
+                unsigned long long n_read   = 0;
+                for (unsigned long long b = 0; b < n_blocks; ++b)
+                  {
+                    t            = reader.expect(4, 4, "a node block header");
+                    const auto n = reader.count(t[3], "node count of a block");
+                    const bool parametric = t[2] != "0";
+                    for (unsigned long long i = 0; i < n; ++i)
+                      reader.add_node(nodes,
+                                      reader.expect(1, 1, "a node tag")[0]);
+                    for (unsigned long long i = 0; i < n; ++i)
+                      {
+                        t = reader.expect(3,
+                                          parametric ? 6 : 3,
+                                          "node coordinates 'x y z'");
+                        for (const auto &x : t)
+                          reader.coordinate(x);
+                      }
+                    n_read += n;
+                  }
+                if (n_read != n_total)
+                  reader.fail("the node blocks hold " + std::to_string(n_read) +
+                              " nodes, the header says " +
+                              std::to_string(n_total));
+                reader.end_of("Nodes");
+                have_nodes = true;
+              }
+            else if (t[0] == "$Elements")
+              {
+                if (!have_nodes)
+                  reader.fail("$Elements before $Nodes");
+                t = reader.expect(4, 4, "'numEntityBlocks numElements ...'");
+                const auto n_blocks = reader.count(t[0], "block count");
+                for (unsigned long long b = 0; b < n_blocks; ++b)
+                  {
+                    t = reader.expect(4, 4, "an element block header");
+                    const unsigned int n_v =
+                      n_nodes(reader.tag(t[2], "element type"), reader);
+                    const auto n =
+                      reader.count(t[3], "element count of a block");
+                    if (t[0] == "2" &&
+                        unnamed_surfaces.count(reader.tag(t[1], "entity tag")))
+                      reader.fail("surface " + t[1] +
+                                  " has no physical group, so its cells have "
+                                  "no material id (give every surface a "
+                                  "Physical Surface)");
+                    for (unsigned long long i = 0; i < n; ++i)
+                      {
+                        t = reader.expect(1 + n_v,
+                                          1 + n_v,
+                                          "an element 'tag nodes...'");
+                        reader.check_element_nodes(nodes, t, 1);
+                      }
+                  }
+                reader.end_of("Elements");
+                have_elements = true;
+              }
+            else if (t[0].size() > 1 && t[0][0] == '$')
+              reader.skip_section(t[0].substr(1));
+          }
+        if (!have_entities || !have_nodes || !have_elements)
+          reader.fail("no $Entities, $Nodes or $Elements section "
+                      "(truncated?)");
+      }
+    } // namespace
+
+
+
+    std::vector<std::string>
+    arguments(const std::string &text)
+    {
+      std::vector<std::string> words;
+      std::istringstream       in(text);
+      for (std::string w; in >> w;)
+        words.push_back(w);
+      const std::set<std::string> one_number = {
+        "-clscale", "-clmin", "-clmax", "-clcurv", "-smooth"};
+      const auto refuse = [&](const std::string &why) {
+        throw std::runtime_error("Mesh/Gmsh arguments: " + why +
+                                 " (allowed: -setnumber NAME NUMBER, "
+                                 "-clscale, -clmin, -clmax, -clcurv, -smooth "
+                                 "NUMBER)");
+      };
+      for (std::size_t i = 0; i < words.size();)
+        if (words[i] == "-setnumber")
+          {
+            if (i + 2 >= words.size() || !is_number(words[i + 2]) ||
+                words[i + 1].find_first_not_of(
+                  "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                  "0123456789_.") != std::string::npos)
+              refuse("-setnumber needs a name and a finite number");
+            i += 3;
+          }
+        else if (one_number.count(words[i]) != 0)
+          {
+            if (i + 1 >= words.size() || !is_number(words[i + 1]))
+              refuse(words[i] + " needs a finite number");
+            i += 2;
+          }
+        else
+          refuse("'" + words[i] + "' is not allowed");
+      return words;
+    }
+
+
+
+    void
+    check_geo(const std::string &file)
+    {
+      std::set<std::string> visited;
+      // Recursion through Include, depth-limited against include cycles.
+      const std::function<void(const std::string &, unsigned int)> check =
+        [&](const std::string &name, const unsigned int depth) {
+          const std::string canonical =
+            std::filesystem::weakly_canonical(name).string();
+          if (!visited.insert(canonical).second)
+            return;
+          if (depth > 16)
+            throw std::runtime_error("Mesh/File: '" + file +
+                                     "': Include nested deeper than 16");
+          std::ifstream in(name);
+          if (!in)
+            throw std::runtime_error("Mesh/File: cannot open '" + name +
+                                     "' (included by '" + file + "')");
+          std::stringstream buffer;
+          buffer << in.rdbuf();
+          std::string text = buffer.str();
+          // Blank out comments, keeping line breaks for the line numbers.
+          for (std::size_t i = 0; i + 1 < text.size(); ++i)
+            if (text[i] == '/' && text[i + 1] == '/')
+              for (; i < text.size() && text[i] != '\n'; ++i)
+                text[i] = ' ';
+            else if (text[i] == '/' && text[i + 1] == '*')
+              for (;
+                   i < text.size() && !(text[i] == '*' && i + 1 < text.size() &&
+                                        text[i + 1] == '/');
+                   ++i)
+                if (text[i] != '\n')
+                  text[i] = ' ';
+          static const std::set<std::string> forbidden = {
+            "SystemCall",
+            "NonBlockingSystemCall",
+            "OnelabRun",
+            "Merge",
+            "MergeWithBoundingBox",
+            "Save",
+            "Print",
+            "CreateDir",
+            "DeleteFile",
+            "RenameFile",
+            "Plugin",
+            "Shell"};
+          unsigned int line = 1;
+          for (std::size_t i = 0; i < text.size();)
+            {
+              const char c = text[i];
+              if (c == '\n')
+                {
+                  ++line;
+                  ++i;
+                  continue;
+                }
+              if (!(std::isalpha(static_cast<unsigned char>(c)) || c == '_'))
+                {
+                  ++i;
+                  continue;
+                }
+              std::size_t j = i;
+              while (j < text.size() &&
+                     (std::isalnum(static_cast<unsigned char>(text[j])) ||
+                      text[j] == '_' || text[j] == '.'))
+                ++j;
+              const std::string word = text.substr(i, j - i);
+              const std::size_t end  = text.find(';', j);
+              const std::string statement =
+                text.substr(j, end == std::string::npos ? end : end - j);
+              const auto where =
+                "Mesh/File: '" + name + "' line " + std::to_string(line) + ": ";
+              if (forbidden.count(word) != 0 || word.rfind("Solver.", 0) == 0 ||
+                  (word == "Printf" &&
+                   statement.find('>') != std::string::npos))
+                throw std::runtime_error(
+                  where + "'" + word +
+                  "' runs programs or writes files; knee_contact does not "
+                  "run such a .geo (mesh it yourself and give the .msh)");
+              if (word == "Include")
+                {
+                  const auto open  = statement.find('"');
+                  const auto close = statement.find('"', open + 1);
+                  if (open == std::string::npos || close == std::string::npos)
+                    throw std::runtime_error(where +
+                                             "Include without a file name");
+                  const std::filesystem::path included =
+                    statement.substr(open + 1, close - open - 1);
+                  check(included.is_absolute()
+                          ? included.string()
+                          : (std::filesystem::path(name).parent_path() /
+                             included)
+                              .string(),
+                        depth + 1);
+                }
+              i = j;
+            }
+        };
+      check(file, 0);
+    }
+
+
+
+    void
+    mesh(const std::string              &geo,
+         const std::string              &msh,
+         const std::vector<std::string> &extra,
+         const double                    time_limit)
+    {
+      check_geo(geo);
+      // Format 4.1: its $Entities section lists every surface, so a surface
+      // without a physical group (whose cells GridIn would drop silently)
+      // can be found by check_msh.
+      std::vector<std::string> command = {
+        "gmsh", "-2", "-format", "msh41", "-v", "2", "-nopopup"};
+      command.insert(command.end(), extra.begin(), extra.end());
+      command.insert(command.end(), {"-o", msh, geo});
+      const std::string log =
+        std::filesystem::path(msh).replace_extension(".log").string();
+      const ProgramResult result = run_program(command, log, time_limit);
+      if (result.exit_code != 0 || !std::ifstream(msh).good() ||
+          result.message.find("rror") != std::string::npos)
+        throw std::runtime_error(
+          "Mesh/File: " +
+          describe_failure(
+            result, "gmsh", geo, "Mesh/Gmsh time limit", time_limit));
+    }
+
+
+
+    void
+    check_msh(const std::string &file)
+    {
+      MshReader                reader(file);
+      std::vector<std::string> t;
+      if (!reader.next(t) || t.size() != 1 || t[0] != "$MeshFormat")
+        reader.fail("not a Gmsh .msh file (no $MeshFormat on line 1)");
+      t = reader.expect(3, 3, "'version file-type data-size'");
+      if (t[1] != "0")
+        reader.fail("binary .msh files are not supported; save as ASCII "
+                    "(Mesh.Binary = 0)");
+      const std::string version = t[0];
+      reader.end_of("MeshFormat");
+      if (version == "2.2" || version == "2")
+        check_msh2(reader);
+      else if (version == "4.1")
+        check_msh4(reader);
+      else
+        reader.fail("format version " + version +
+                    " is not supported (2.2 or 4.1)");
+    }
+  } // namespace gmsh_input
+} // namespace knee_contact

@@ -1,0 +1,239 @@
+#include <knee_contact/mesh/scene_checks.h>
+
+#include <deal.II/base/bounding_box.h>
+#include <deal.II/base/quadrature_lib.h>
+
+#include <deal.II/lac/vector.h>
+
+#include <deal.II/fe/mapping.h>
+#include <deal.II/grid/grid_tools.h>
+#include <deal.II/numerics/rtree.h>
+
+#include <boost/geometry/index/rtree.hpp>
+
+#include <cmath>
+#include <iomanip>
+#include <numeric>
+#include <sstream>
+
+namespace knee_contact
+{
+  namespace scene_checks
+  {
+    namespace
+    {
+      std::string
+      at(const Point<2> &p)
+      {
+        std::ostringstream out;
+        out << std::setprecision(6) << "(" << p[0] << ", " << p[1] << ")";
+        return out.str();
+      }
+
+      std::string
+      type_name(const BoundaryType type)
+      {
+        switch (type)
+          {
+            case BoundaryType::displacement:
+              return "displacement";
+            case BoundaryType::traction:
+              return "traction";
+            case BoundaryType::pressure:
+              return "pressure";
+            default:
+              return "sliding";
+          }
+      }
+    } // namespace
+
+
+
+    void
+    check_roles(const BoundaryConditions &conditions,
+                const ContactInterfaces  &interfaces)
+    {
+      for (const auto &interface : interfaces.interfaces())
+        for (const auto id : {interface.slave_id, interface.master_id})
+          for (const auto &condition : conditions.conditions())
+            AssertThrow(condition.ids.count(id) == 0,
+                        ExcMessage(
+                          condition.name + "/Boundary ids: boundary id " +
+                          std::to_string(id) + " is a contact side of '" +
+                          interface.name + "' and cannot also carry a " +
+                          type_name(condition.type) +
+                          " condition (one role per boundary id)"));
+    }
+
+
+
+    void
+    check_finite_data(const Triangulation<2>   &triangulation,
+                      const Materials          &materials,
+                      const BoundaryConditions &conditions)
+    {
+      const QGauss<1> face_points(2);
+      Vector<double>  values(2);
+      const auto      check = [&](const Function<2> &function,
+                             const Point<2>    &p,
+                             const std::string &parameter,
+                             const std::string &where) {
+        function.vector_value(p, values);
+        for (unsigned int c = 0; c < function.n_components; ++c)
+          AssertThrow(std::isfinite(values(c)),
+                      ExcMessage(parameter +
+                                 ": not finite (inf or nan) at (x, y) = " +
+                                 at(p) + where));
+      };
+      for (const auto &cell : triangulation.active_cell_iterators())
+        {
+          const Material   &material = materials[cell->material_id()];
+          const auto       &force    = *material.body_force;
+          const std::string parameter =
+            "Materials (material '" + material.name + "')/Body force";
+          for (const auto v : cell->vertex_indices())
+            check(force, cell->vertex(v), parameter, "");
+          // The Gauss points, mapped as the assembly maps them.
+          const auto &mapping =
+            cell->reference_cell().get_default_linear_mapping<2, 2>();
+          // (The rule is kept in a named variable: a range-for over a
+          // member of a temporary would read freed stack memory.)
+          const Quadrature<2> cell_points =
+            cell->reference_cell().get_gauss_type_quadrature<2>(2);
+          for (const auto &xi : cell_points.get_points())
+            check(force,
+                  mapping.transform_unit_to_real_cell(cell, xi),
+                  parameter,
+                  "");
+          for (const auto f : cell->face_indices())
+            if (cell->face(f)->at_boundary())
+              for (const auto &condition : conditions.conditions())
+                if (condition.function &&
+                    condition.ids.count(cell->face(f)->boundary_id()) != 0)
+                  {
+                    const std::string where =
+                      " on boundary id " +
+                      std::to_string(cell->face(f)->boundary_id());
+                    const Point<2> a = cell->face(f)->vertex(0),
+                                   b = cell->face(f)->vertex(1);
+                    check(*condition.function,
+                          a,
+                          condition.name + "/Value",
+                          where);
+                    check(*condition.function,
+                          b,
+                          condition.name + "/Value",
+                          where);
+                    for (const auto &s : face_points.get_points())
+                      check(*condition.function,
+                            Point<2>(a + s[0] * (b - a)),
+                            condition.name + "/Value",
+                            where);
+                  }
+        }
+    }
+
+
+
+    void
+    check_joints(const Triangulation<2>          &triangulation,
+                 const std::vector<unsigned int> &body_of_cell)
+    {
+      // Boundary edges of one body on top of each other: a crack where
+      // bonded edges do not match. Found through an R-tree of the boundary
+      // faces' bounding boxes.
+      struct Edge
+      {
+        Point<2>     a, b;
+        unsigned int body;
+      };
+      std::vector<Edge>                                    edges;
+      std::vector<std::pair<BoundingBox<2>, unsigned int>> boxes;
+      for (const auto &cell : triangulation.active_cell_iterators())
+        for (const auto f : cell->face_indices())
+          if (cell->face(f)->at_boundary())
+            {
+              const Edge e{cell->face(f)->vertex(0),
+                           cell->face(f)->vertex(1),
+                           body_of_cell[cell->active_cell_index()]};
+              boxes.emplace_back(
+                BoundingBox<2>(std::vector<Point<2>>{e.a, e.b}), edges.size());
+              edges.push_back(e);
+            }
+      const auto tree = pack_rtree(boxes);
+      for (unsigned int i = 0; i < edges.size(); ++i)
+        {
+          const Edge        &e      = edges[i];
+          const Tensor<1, 2> t      = e.b - e.a;
+          const double       length = t.norm();
+          const double       tol    = 1e-8 * length;
+          std::vector<std::pair<BoundingBox<2>, unsigned int>> near;
+          tree.query(boost::geometry::index::intersects(boxes[i].first),
+                     std::back_inserter(near));
+          for (const auto &[box, j] : near)
+            {
+              if (j <= i || edges[j].body != e.body)
+                continue;
+              const Edge &o = edges[j];
+              // Collinear and overlapping along a positive length.
+              const auto offset = [&](const Point<2> &p) {
+                return std::abs(t[0] * (p - e.a)[1] - t[1] * (p - e.a)[0]) /
+                       length;
+              };
+              if (offset(o.a) > tol || offset(o.b) > tol)
+                continue;
+              const double s0      = (o.a - e.a) * t / length,
+                           s1      = (o.b - e.a) * t / length;
+              const double overlap = std::min(length, std::max(s0, s1)) -
+                                     std::max(0., std::min(s0, s1));
+              AssertThrow(overlap <= tol,
+                          ExcMessage(
+                            "Mesh: two boundary edges of body " +
+                            std::to_string(e.body) +
+                            " lie on top of each "
+                            "other near " +
+                            at(e.a + 0.5 * t) +
+                            ": bonded edges whose vertices do not match (a "
+                            "crack); make the vertices match or use "
+                            "different groups and a contact interface"));
+            }
+        }
+
+      // Around each vertex, the cells that share it must be connected
+      // through faces that contain it (Triangulation's vertex_to_cell_map).
+      const auto cells_at = GridTools::vertex_to_cell_map(triangulation);
+      for (unsigned int v = 0; v < cells_at.size(); ++v)
+        {
+          if (cells_at[v].size() < 2)
+            continue;
+          std::vector<Triangulation<2>::active_cell_iterator> around(
+            cells_at[v].begin(), cells_at[v].end());
+          std::vector<unsigned int> parent(around.size());
+          std::iota(parent.begin(), parent.end(), 0);
+          const auto find = [&](unsigned int i) {
+            while (parent[i] != i)
+              i = parent[i];
+            return i;
+          };
+          for (unsigned int i = 0; i < around.size(); ++i)
+            for (const auto f : around[i]->face_indices())
+              if (!around[i]->at_boundary(f) &&
+                  (around[i]->face(f)->vertex_index(0) == v ||
+                   around[i]->face(f)->vertex_index(1) == v))
+                for (unsigned int j = 0; j < around.size(); ++j)
+                  if (around[i]->neighbor(f) == around[j])
+                    parent[find(i)] = find(j);
+          unsigned int n_groups = 0;
+          for (unsigned int i = 0; i < around.size(); ++i)
+            n_groups += find(i) == i;
+          AssertThrow(n_groups == 1,
+                      ExcMessage("Mesh: cells meet only at the vertex " +
+                                 at(triangulation.get_vertices()[v]) +
+                                 ", not along an edge (bodies joined at a "
+                                 "single point); bonded parts must share an "
+                                 "edge, parts in contact must not share "
+                                 "vertices"));
+        }
+    }
+  } // namespace scene_checks
+} // namespace knee_contact

@@ -1,0 +1,176 @@
+#include <knee_contact/physics/boundary_conditions.h>
+#include <knee_contact/physics/elements.h>
+#include <knee_contact/core/input.h>
+
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/fe/mapping_q1.h>
+#include <deal.II/numerics/vector_tools.h>
+
+#include <cmath>
+
+namespace knee_contact
+{
+  void
+  BoundaryConditions::declare_parameters(ParameterHandler  &prm,
+                                         const unsigned int n_conditions)
+  {
+    prm.enter_subsection("Boundary conditions");
+    prm.declare_entry("Number of conditions",
+                      "0",
+                      Patterns::Integer(0, 255),
+                      "How many subsections 'Condition 0', 'Condition 1', "
+                      "... follow. Boundaries without a condition are free "
+                      "(P = 0).");
+    for (unsigned int c = 0; c < n_conditions; ++c)
+      {
+        prm.enter_subsection("Condition " + std::to_string(c));
+        prm.declare_entry("Boundary ids",
+                          "",
+                          Patterns::List(Patterns::Integer(0, 254)),
+                          "Boundary ids (Gmsh: physical curve tags) this "
+                          "condition applies to.");
+        prm.declare_entry(
+          "Type",
+          "displacement",
+          Patterns::Selection("displacement|traction|pressure|sliding"),
+          "displacement: u = u0 on Gamma_u; traction: tau.n = P on "
+          "Gamma_tau; pressure: tau.n = -p n (p > 0 pushes into the body); "
+          "sliding: u.n = 0 and zero tangential traction on Gamma_o.");
+        prm.declare_entry("Components",
+                          "x, y",
+                          Patterns::MultipleSelection("x|y"),
+                          "For displacement: the components of u0 that are "
+                          "prescribed; the others stay free.");
+        prm.declare_entry("Value",
+                          "0; 0",
+                          Patterns::Anything(),
+                          "Expression in x, y [m]: u0 = (u_x; u_y) [m] for "
+                          "displacement, P = (P_x; P_y) [Pa] for traction, "
+                          "p [Pa] for pressure; unused for sliding.");
+        prm.leave_subsection();
+      }
+    prm.leave_subsection();
+  }
+
+
+
+  void
+  BoundaryConditions::parse_parameters(ParameterHandler  &prm,
+                                       const unsigned int n_conditions)
+  {
+    prm.enter_subsection("Boundary conditions");
+    std::map<types::boundary_id, std::string> used;
+    for (unsigned int c = 0; c < n_conditions; ++c)
+      {
+        BoundaryCondition condition;
+        condition.name = "Boundary conditions/Condition " + std::to_string(c);
+        prm.enter_subsection("Condition " + std::to_string(c));
+        const std::string type = prm.get("Type");
+        condition.type = type == "displacement" ? BoundaryType::displacement
+                         : type == "traction"   ? BoundaryType::traction
+                         : type == "pressure"   ? BoundaryType::pressure
+                                                : BoundaryType::sliding;
+        for (const auto &id :
+             Utilities::split_string_list(prm.get("Boundary ids")))
+          {
+            const auto b = static_cast<types::boundary_id>(std::stoi(id));
+            AssertThrow(used.find(b) == used.end(),
+                        ExcMessage(condition.name +
+                                   "/Boundary ids: boundary "
+                                   "id " +
+                                   id + " already has a condition in " +
+                                   used[b]));
+            used[b] = condition.name;
+            condition.ids.insert(b);
+          }
+        AssertThrow(!condition.ids.empty(),
+                    ExcMessage(condition.name + "/Boundary ids: empty list"));
+        const std::string components = prm.get("Components");
+        condition.mask               = ComponentMask(
+          std::vector<bool>{components.find('x') != std::string::npos,
+                                          components.find('y') != std::string::npos});
+        AssertThrow(condition.type != BoundaryType::displacement ||
+                      condition.mask.n_selected_components() > 0,
+                    ExcMessage(condition.name +
+                               "/Components: no component selected"));
+        if (condition.type != BoundaryType::sliding)
+          condition.function = input::parse_expression(
+            prm.get("Value"),
+            condition.type == BoundaryType::pressure ? 1 : 2,
+            condition.name + "/Value",
+            "",
+            condition.type != BoundaryType::displacement);
+        prm.leave_subsection();
+        list.push_back(std::move(condition));
+      }
+    prm.leave_subsection();
+  }
+
+
+
+  void
+  BoundaryConditions::check_mesh(const Triangulation<2> &triangulation) const
+  {
+    const auto ids = triangulation.get_boundary_ids();
+    for (const auto &condition : list)
+      for (const auto id : condition.ids)
+        AssertThrow(std::find(ids.begin(), ids.end(), id) != ids.end(),
+                    ExcMessage(condition.name +
+                               "/Boundary ids: the mesh has "
+                               "no boundary id " +
+                               std::to_string(id)));
+  }
+
+
+
+  void
+  BoundaryConditions::make_constraints(
+    const DoFHandler<2>       &dof_handler,
+    AffineConstraints<double> &constraints) const
+  {
+    // Hanging nodes of adaptive refinement first; in 2D they never lie on
+    // the boundary, so they do not meet the lines below.
+    constraints.clear();
+    DoFTools::make_hanging_node_constraints(dof_handler, constraints);
+    for (const auto &condition : list)
+      if (condition.type == BoundaryType::displacement)
+        for (const auto id : condition.ids)
+          VectorTools::interpolate_boundary_values(elements::mapping(
+                                                     dof_handler),
+                                                   dof_handler,
+                                                   id,
+                                                   *condition.function,
+                                                   constraints,
+                                                   condition.mask);
+
+    std::set<types::boundary_id> sliding;
+    for (const auto &condition : list)
+      if (condition.type == BoundaryType::sliding)
+        sliding.insert(condition.ids.begin(), condition.ids.end());
+    if (!sliding.empty())
+      {
+        AffineConstraints<double> sliding_constraints;
+        VectorTools::compute_no_normal_flux_constraints(dof_handler,
+                                                        0,
+                                                        sliding,
+                                                        sliding_constraints,
+                                                        elements::mapping(
+                                                          dof_handler));
+        sliding_constraints.close();
+        constraints.merge(
+          sliding_constraints,
+          AffineConstraints<double>::MergeConflictBehavior::left_object_wins);
+      }
+    constraints.close();
+  }
+
+
+  void
+  BoundaryConditions::set_load_parameter(const double t)
+  {
+    for (auto &condition : list)
+      if (condition.type == BoundaryType::traction ||
+          condition.type == BoundaryType::pressure)
+        condition.function->set_time(t);
+  }
+} // namespace knee_contact

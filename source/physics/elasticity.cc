@@ -1,0 +1,200 @@
+#include <knee_contact/physics/elasticity.h>
+#include <knee_contact/physics/elements.h>
+
+#include <deal.II/base/quadrature_lib.h>
+#include <deal.II/base/work_stream.h>
+
+#include <deal.II/fe/fe_values.h>
+
+namespace knee_contact
+{
+  namespace
+  {
+    struct ScratchData
+    {
+      ScratchData(const DoFHandler<2> &dof_handler)
+        : fe_values(elements::mapping(dof_handler),
+                    dof_handler.get_fe(),
+                    elements::cell_quadrature(dof_handler, 2),
+                    update_values | update_gradients |
+                      update_quadrature_points | update_JxW_values)
+        , fe_values_reduced(elements::mapping(dof_handler),
+                            dof_handler.get_fe(),
+                            elements::cell_quadrature(dof_handler, 1),
+                            update_gradients | update_JxW_values)
+        , fe_face_values(elements::mapping(dof_handler),
+                         dof_handler.get_fe(),
+                         QGauss<1>(2),
+                         update_values | update_quadrature_points |
+                           update_normal_vectors | update_JxW_values)
+      {}
+
+      ScratchData(const ScratchData &other)
+        : fe_values(other.fe_values.get_mapping(),
+                    other.fe_values.get_fe(),
+                    other.fe_values.get_quadrature(),
+                    other.fe_values.get_update_flags())
+        , fe_values_reduced(other.fe_values_reduced.get_mapping(),
+                            other.fe_values_reduced.get_fe(),
+                            other.fe_values_reduced.get_quadrature(),
+                            other.fe_values_reduced.get_update_flags())
+        , fe_face_values(other.fe_face_values.get_mapping(),
+                         other.fe_face_values.get_fe(),
+                         other.fe_face_values.get_quadrature(),
+                         other.fe_face_values.get_update_flags())
+      {}
+
+      FEValues<2>     fe_values;
+      FEValues<2>     fe_values_reduced;
+      FEFaceValues<2> fe_face_values;
+    };
+
+    struct CopyData
+    {
+      FullMatrix<double>                   cell_matrix;
+      Vector<double>                       cell_rhs;
+      std::vector<types::global_dof_index> dof_indices;
+    };
+  } // namespace
+
+
+
+  ElasticityAssembler::ElasticityAssembler(
+    const Materials          &materials,
+    const BoundaryConditions &boundary_conditions)
+    : materials(materials)
+    , boundary_conditions(boundary_conditions)
+  {}
+
+
+
+  void
+  ElasticityAssembler::assemble(const DoFHandler<2>  &dof_handler,
+                                SparseMatrix<double> &matrix,
+                                Vector<double>       &rhs) const
+  {
+    matrix = 0;
+    assemble(dof_handler, &matrix, rhs);
+  }
+
+
+
+  void
+  ElasticityAssembler::assemble_rhs(const DoFHandler<2> &dof_handler,
+                                    Vector<double>      &rhs) const
+  {
+    assemble(dof_handler, nullptr, rhs);
+  }
+
+
+
+  void
+  ElasticityAssembler::assemble(const DoFHandler<2>  &dof_handler,
+                                SparseMatrix<double> *matrix,
+                                Vector<double>       &rhs) const
+  {
+    rhs.reinit(dof_handler.n_dofs());
+    const bool with_matrix = matrix != nullptr;
+
+    // a(u, v) = int e(v) : c : e(u) dx and L(v) = int F.v dx + int P.v ds,
+    // the seed's eq. (5), cell by cell.
+    const auto worker = [this, with_matrix](
+                          const DoFHandler<2>::active_cell_iterator &cell,
+                          ScratchData                               &scratch,
+                          CopyData                                  &copy) {
+      const FiniteElement<2> &fe       = cell->get_fe();
+      const unsigned int      n        = fe.n_dofs_per_cell();
+      const Material         &material = materials[cell->material_id()];
+      copy.cell_matrix.reinit(n, n);
+      copy.cell_rhs.reinit(n);
+      copy.dof_indices.resize(n);
+      cell->get_dof_indices(copy.dof_indices);
+
+      // A further load case with zero body force needs only the faces.
+      const bool volume = with_matrix || !material.body_force_is_zero;
+      if (volume)
+        scratch.fe_values.reinit(cell);
+      const FEValues<2> &fev = scratch.fe_values;
+      Vector<double>     force(2);
+      for (unsigned int q = 0; volume && q < fev.n_quadrature_points; ++q)
+        {
+          if (!material.body_force_is_zero)
+            material.body_force->vector_value(fev.quadrature_point(q), force);
+          for (unsigned int i = 0; i < n; ++i)
+            {
+              const unsigned int ci = fe.system_to_component_index(i).first;
+              const Tensor<1, 2> gi = fev.shape_grad(i, q);
+              for (unsigned int j = 0; with_matrix && j < n; ++j)
+                {
+                  const unsigned int cj = fe.system_to_component_index(j).first;
+                  const Tensor<1, 2> gj = fev.shape_grad(j, q);
+                  // c_ijkl for isotropic material, written per component
+                  // pair as in step-8.
+                  const double lambda =
+                    material.reduced_volumetric ? 0. : material.lambda;
+                  copy.cell_matrix(i, j) +=
+                    (gi[ci] * gj[cj] * lambda + gi[cj] * gj[ci] * material.mu +
+                     (ci == cj ? gi * gj * material.mu : 0.)) *
+                    fev.JxW(q);
+                }
+              copy.cell_rhs(i) +=
+                fev.shape_value(i, q) * force(ci) * fev.JxW(q);
+            }
+        }
+
+      if (with_matrix && material.reduced_volumetric)
+        {
+          scratch.fe_values_reduced.reinit(cell);
+          const FEValues<2> &fer = scratch.fe_values_reduced;
+          for (const unsigned int q : fer.quadrature_point_indices())
+            for (unsigned int i = 0; i < n; ++i)
+              for (unsigned int j = 0; j < n; ++j)
+                copy.cell_matrix(i, j) +=
+                  fer.shape_grad(i, q)[fe.system_to_component_index(i).first] *
+                  fer.shape_grad(j, q)[fe.system_to_component_index(j).first] *
+                  material.lambda * fer.JxW(q);
+        }
+
+      for (const unsigned int f : cell->face_indices())
+        if (cell->face(f)->at_boundary())
+          for (const auto &condition : boundary_conditions.conditions())
+            if ((condition.type == BoundaryType::traction ||
+                 condition.type == BoundaryType::pressure) &&
+                condition.ids.count(cell->face(f)->boundary_id()))
+              {
+                scratch.fe_face_values.reinit(cell, f);
+                const FEFaceValues<2> &fv = scratch.fe_face_values;
+                for (const unsigned int q : fv.quadrature_point_indices())
+                  {
+                    Tensor<1, 2> traction;
+                    if (condition.type == BoundaryType::pressure)
+                      traction =
+                        -condition.function->value(fv.quadrature_point(q)) *
+                        fv.normal_vector(q);
+                    else
+                      for (unsigned int d = 0; d < 2; ++d)
+                        traction[d] =
+                          condition.function->value(fv.quadrature_point(q), d);
+                    for (unsigned int i = 0; i < n; ++i)
+                      copy.cell_rhs(i) +=
+                        fv.shape_value(i, q) *
+                        traction[fe.system_to_component_index(i).first] *
+                        fv.JxW(q);
+                  }
+              }
+    };
+
+    const auto copier = [matrix, &rhs](const CopyData &copy) {
+      if (matrix != nullptr)
+        matrix->add(copy.dof_indices, copy.cell_matrix);
+      rhs.add(copy.dof_indices, copy.cell_rhs);
+    };
+
+    WorkStream::run(dof_handler.begin_active(),
+                    dof_handler.end(),
+                    worker,
+                    copier,
+                    ScratchData(dof_handler),
+                    CopyData());
+  }
+} // namespace knee_contact

@@ -1,0 +1,238 @@
+#include <knee_contact/core/input.h>
+#include <knee_contact/physics/materials.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+
+namespace knee_contact
+{
+  SymmetricTensor<2, 2>
+  Material::stress(const SymmetricTensor<2, 2> &strain) const
+  {
+    return lambda * trace(strain) * unit_symmetric_tensor<2>() +
+           2. * mu * strain;
+  }
+
+
+
+  double
+  Material::stress_zz(const SymmetricTensor<2, 2> &stress) const
+  {
+    return plane_strain ? poissons_ratio * trace(stress) : 0.;
+  }
+
+
+
+  double
+  Material::von_mises(const SymmetricTensor<2, 2> &s) const
+  {
+    const double szz = stress_zz(s);
+    return std::sqrt(0.5 * ((s[0][0] - s[1][1]) * (s[0][0] - s[1][1]) +
+                            (s[1][1] - szz) * (s[1][1] - szz) +
+                            (szz - s[0][0]) * (szz - s[0][0])) +
+                     3. * s[0][1] * s[0][1]);
+  }
+
+
+
+  void
+  Materials::declare_parameters(ParameterHandler  &prm,
+                                const unsigned int n_materials)
+  {
+    prm.enter_subsection("Materials");
+    prm.declare_entry("Number of materials",
+                      "1",
+                      Patterns::Integer(1, 255),
+                      "How many subsections 'Material 0', 'Material 1', ... "
+                      "follow.");
+    prm.declare_entry("Plane",
+                      "strain",
+                      Patterns::Selection("strain|stress"),
+                      "2D model: plane strain (e_zz = 0, the default) or "
+                      "plane stress (tau_zz = 0).");
+    for (unsigned int m = 0; m < n_materials; ++m)
+      {
+        prm.enter_subsection("Material " + std::to_string(m));
+        prm.declare_entry("Material id",
+                          std::to_string(m + 1),
+                          Patterns::Integer(0, 254),
+                          "Material id of the cells (Gmsh: the physical "
+                          "surface's tag).");
+        prm.declare_entry("Name",
+                          "material " + std::to_string(m + 1),
+                          Patterns::Anything(),
+                          "Name shown in results.");
+        prm.declare_entry("Young's modulus",
+                          "1e9",
+                          Patterns::Double(),
+                          "Young's modulus E [Pa], > 0.");
+        prm.declare_entry("Poisson's ratio",
+                          "0.3",
+                          Patterns::Double(),
+                          "Poisson's ratio nu, in (-1, 0.5).");
+        prm.declare_entry("Volumetric integration",
+                          "full",
+                          Patterns::Selection("full|reduced"),
+                          "full: 2x2 Gauss points for the whole stiffness; "
+                          "reduced: the volumetric part lambda div u div v "
+                          "with one point (selective reduced integration), "
+                          "against locking when nu is close to 0.5.");
+        prm.declare_entry("Body force",
+                          "0; 0",
+                          Patterns::Anything(),
+                          "Body force F = (F_x; F_y) [N/m^3] of the seed's "
+                          "eq. (1), an expression in x, y [m].");
+        prm.leave_subsection();
+      }
+    prm.leave_subsection();
+  }
+
+
+
+  void
+  Materials::parse_parameters(ParameterHandler  &prm,
+                              const unsigned int n_materials)
+  {
+    prm.enter_subsection("Materials");
+    const bool plane_strain = prm.get("Plane") == "strain";
+    for (unsigned int m = 0; m < n_materials; ++m)
+      {
+        const std::string section = "Material " + std::to_string(m);
+        prm.enter_subsection(section);
+        const auto id =
+          static_cast<types::material_id>(prm.get_integer("Material id"));
+        AssertThrow(materials.find(id) == materials.end(),
+                    ExcMessage("Materials/" + section + ": material id " +
+                               std::to_string(id) +
+                               " is given to more than one material"));
+        Material &material = materials[id];
+        material.name      = prm.get("Name");
+        input::check_name(material.name, "Materials/" + section + "/Name");
+        for (const auto &[other_id, other] : materials)
+          AssertThrow(other_id == id || other.name != material.name,
+                      ExcMessage("Materials/" + section + "/Name: '" +
+                                 material.name +
+                                 "' is the name of another material too"));
+        material.youngs_modulus = prm.get_double("Young's modulus");
+        material.poissons_ratio = prm.get_double("Poisson's ratio");
+        material.plane_strain   = plane_strain;
+        material.reduced_volumetric =
+          prm.get("Volumetric integration") == "reduced";
+        const double E  = material.youngs_modulus;
+        const double nu = material.poissons_ratio;
+        AssertThrow(std::isfinite(E) && E > 0,
+                    ExcMessage("Materials/" + section +
+                               "/Young's modulus: E must be > 0, got " +
+                               prm.get("Young's modulus")));
+        // Beyond these the stiffness or the displacement leaves the range
+        // of double precision (E = 1e-300 gives an infinite energy).
+        AssertThrow(E >= 1e-20 && E <= 1e30,
+                    ExcMessage(
+                      "Materials/" + section +
+                      "/Young's modulus: E = " + prm.get("Young's modulus") +
+                      " is outside [1e-20, 1e30] (choose units "
+                      "that keep E and the loads near 1)"));
+        AssertThrow(std::isfinite(nu) && nu > -1 && nu < 0.5,
+                    ExcMessage("Materials/" + section +
+                               "/Poisson's ratio: nu must lie in (-1, 0.5), "
+                               "got " +
+                               prm.get("Poisson's ratio")));
+        material.mu     = E / (2 * (1 + nu));
+        material.lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
+        if (!plane_strain)
+          material.lambda = 2 * material.lambda * material.mu /
+                            (material.lambda + 2 * material.mu);
+        material.body_force =
+          input::parse_expression(prm.get("Body force"),
+                                  2,
+                                  "Materials/" + section + "/Body force",
+                                  "",
+                                  true);
+        // Written as zeros ("0; 0", the default): assembly skips it.
+        material.body_force_is_zero = true;
+        for (const auto &part : input::split(prm.get("Body force"), ';'))
+          {
+            char        *end   = nullptr;
+            const double value = std::strtod(part.c_str(), &end);
+            material.body_force_is_zero &=
+              end != part.c_str() && *end == '\0' && value == 0;
+          }
+        prm.leave_subsection();
+      }
+    prm.leave_subsection();
+
+    // A contrast beyond 1e12 leaves fewer than 4 correct digits in the
+    // soft body (round-off grows with the condition number).
+    double E_min = std::numeric_limits<double>::max(), E_max = 0;
+    for (const auto &[id, material] : materials)
+      {
+        E_min = std::min(E_min, material.youngs_modulus);
+        E_max = std::max(E_max, material.youngs_modulus);
+      }
+    std::ostringstream contrast;
+    contrast << std::setprecision(3) << E_max / E_min;
+    AssertThrow(E_max <= 1e12 * E_min,
+                ExcMessage("Materials: the contrast of Young's moduli " +
+                           contrast.str() +
+                           " exceeds 1e12; the soft body's displacements "
+                           "would have no correct digits (model the stiff "
+                           "body as rigid with a displacement condition)"));
+  }
+
+
+
+  void
+  Materials::check_mesh(const Triangulation<2> &triangulation) const
+  {
+    for (const auto &cell : triangulation.active_cell_iterators())
+      AssertThrow(materials.find(cell->material_id()) != materials.end(),
+                  ExcMessage(
+                    "the mesh has cells with material id " +
+                    std::to_string(cell->material_id()) +
+                    " but no subsection of 'Materials' gives that id"));
+  }
+
+
+
+  const Material &
+  Materials::operator[](const types::material_id id) const
+  {
+    const auto it = materials.find(id);
+    Assert(it != materials.end(), ExcInternalError());
+    return it->second;
+  }
+
+
+
+  double
+  Materials::min_youngs_modulus() const
+  {
+    double E = std::numeric_limits<double>::max();
+    for (const auto &m : materials)
+      E = std::min(E, m.second.youngs_modulus);
+    return E;
+  }
+
+
+
+  double
+  Materials::max_youngs_modulus() const
+  {
+    double E = 0;
+    for (const auto &m : materials)
+      E = std::max(E, m.second.youngs_modulus);
+    return E;
+  }
+
+
+  void
+  Materials::set_load_parameter(const double t)
+  {
+    for (auto &m : materials)
+      m.second.body_force->set_time(t);
+  }
+} // namespace knee_contact

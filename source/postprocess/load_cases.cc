@@ -1,0 +1,149 @@
+#include <knee_contact/core/input.h>
+#include <knee_contact/postprocess/load_cases.h>
+
+#include <cmath>
+#include <cstdio>
+#include <iomanip>
+
+namespace knee_contact
+{
+  namespace
+  {
+    // More cases than this is a typing error (a step of 1e-9), not a study.
+    constexpr unsigned int max_cases = 100000;
+  } // namespace
+
+
+
+  void
+  LoadCases::declare_parameters(ParameterHandler &prm)
+  {
+    prm.enter_subsection("Load cases");
+    prm.declare_entry(
+      "Values of t",
+      "",
+      Patterns::Anything(),
+      "The load parameter t of each load case, separated by ','; an entry "
+      "'first:step:last' stands for first, first+step, ..., last. Traction, "
+      "pressure and body force expressions (and exact solutions) may use t; "
+      "displacement conditions may not. Empty: one case at t = 0.");
+    prm.leave_subsection();
+  }
+
+
+
+  void
+  LoadCases::parse_parameters(ParameterHandler &prm)
+  {
+    prm.enter_subsection("Load cases");
+    const std::string parameter = "Load cases/Values of t";
+    const std::string text      = prm.get("Values of t");
+    prm.leave_subsection();
+    t.clear();
+    for (const auto &entry : input::split(text, ','))
+      {
+        const auto range = input::split(entry, ':');
+        if (range.size() == 1)
+          t.push_back(input::to_double(entry, parameter));
+        else
+          {
+            AssertThrow(range.size() == 3,
+                        ExcMessage("parameter '" + parameter + "': '" + entry +
+                                   "' is neither a number nor "
+                                   "first:step:last"));
+            const double first = input::to_double(range[0], parameter);
+            const double step  = input::to_double(range[1], parameter);
+            const double last  = input::to_double(range[2], parameter);
+            const double n     = (last - first) / step;
+            AssertThrow(step > 0 && last >= first && n < max_cases &&
+                          std::abs(n - std::round(n)) <= 1e-9 * (1 + n),
+                        ExcMessage("parameter '" + parameter + "': range '" +
+                                   entry +
+                                   "' needs step > 0, last >= first and last "
+                                   "- first a multiple of step"));
+            for (long i = 0; i <= std::lround(n); ++i)
+              t.push_back(i == std::lround(n) ? last : first + i * step);
+          }
+        AssertThrow(t.size() <= max_cases,
+                    ExcMessage("parameter '" + parameter + "': more than " +
+                               std::to_string(max_cases) + " load cases"));
+      }
+    if (t.empty())
+      t = {0.};
+  }
+
+
+
+  std::string
+  LoadCases::folder(const unsigned int index)
+  {
+    char name[32];
+    std::snprintf(name, sizeof(name), "case_%03u", index);
+    return name;
+  }
+
+
+
+  void
+  LoadCases::write_csv(const std::vector<Record> &records, std::ostream &out)
+  {
+    if (records.empty())
+      return;
+    const Results &first = records.front().results;
+    out << "case,t,iterations,converged,solve_time,energy,max_displacement,"
+           "load_x,load_y";
+    for (const auto &[id, reaction] : first.reactions)
+      out << ",reaction_" << id << "_x,reaction_" << id << "_y";
+    for (const auto &i : first.interfaces)
+      out << ',' << i.name << "_active_pairs," << i.name << "_force," << i.name
+          << "_peak_pressure," << i.name << "_contact_length";
+    out << '\n' << std::setprecision(12);
+    for (unsigned int c = 0; c < records.size(); ++c)
+      {
+        const Record  &r       = records[c];
+        const Results &results = r.results;
+        out << c << ',' << r.t << ',' << r.n_iterations << ','
+            << (r.converged ? "true" : "false") << ',' << r.solve_time << ','
+            << results.energy << ',' << results.max_displacement << ','
+            << results.applied_load[0] << ',' << results.applied_load[1];
+        for (const auto &[id, reaction] : results.reactions)
+          out << ',' << reaction[0] << ',' << reaction[1];
+        for (const auto &i : results.interfaces)
+          out << ',' << i.n_active << ',' << i.force << ',' << i.max_pressure
+              << ',' << i.contact_length;
+        out << '\n';
+      }
+  }
+
+
+
+  void
+  LoadCases::print_table(const std::vector<Record> &records,
+                         const bool                 with_times,
+                         std::ostream              &out)
+  {
+    out << "load cases:\n"
+        << "  case          t  iterations  energy [J/m]  peak pressure [Pa]"
+           "  contact length [m]"
+        << (with_times ? "  solve [s]" : "") << '\n';
+    for (unsigned int c = 0; c < records.size(); ++c)
+      {
+        const Record &r    = records[c];
+        double        peak = 0, length = 0;
+        for (const auto &i : r.results.interfaces)
+          {
+            peak = std::max(peak, i.max_pressure);
+            length += i.contact_length;
+          }
+        out << "  " << std::setw(4) << c << std::setw(11)
+            << std::setprecision(4) << r.t << std::setw(12) << r.n_iterations
+            << std::scientific << std::setprecision(5) << std::setw(14)
+            << r.results.energy << std::setw(20) << peak << std::setw(20)
+            << length << std::defaultfloat << std::setprecision(3);
+        if (with_times)
+          out << std::setw(11) << r.solve_time;
+        out << (r.converged ? "" : "  NOT converged") << '\n';
+      }
+    out << std::flush;
+  }
+} // namespace knee_contact

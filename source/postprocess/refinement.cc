@@ -1,0 +1,207 @@
+#include <knee_contact/physics/elements.h>
+#include <knee_contact/postprocess/refinement.h>
+
+#include <deal.II/base/quadrature_lib.h>
+
+#include <deal.II/grid/grid_refinement.h>
+#include <deal.II/numerics/error_estimator.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <utility>
+#include <vector>
+
+namespace knee_contact
+{
+  void
+  Refinement::declare_parameters(ParameterHandler &prm)
+  {
+    prm.enter_subsection("Refinement");
+    prm.declare_entry("Number of cycles",
+                      "1",
+                      Patterns::Integer(1, 20),
+                      "Solve on this many meshes, refining between them; "
+                      "errors and rates are tabulated.");
+    prm.declare_entry("Number of adaptive cycles",
+                      "0",
+                      Patterns::Integer(0, 30),
+                      "Cycles of the adaptive sequence, which grows more "
+                      "slowly than the uniform one; 0: Number of cycles.");
+    prm.declare_entry("Strategy",
+                      "global",
+                      Patterns::Selection("global|adaptive|compare"),
+                      "global: refine every cell; adaptive: refine the cells "
+                      "with the largest Kelly error estimate (energy "
+                      "weighted); compare: run both sequences and write "
+                      "study.csv, study_error_dofs.png and "
+                      "study_error_time.png (speed against error).");
+    prm.declare_entry("Refine fraction",
+                      "0.5",
+                      Patterns::Double(0, 1),
+                      "Adaptive: refine the cells that together carry this "
+                      "fraction of the estimated error (fixed fraction).");
+    prm.declare_entry("Indicator",
+                      "kelly+contact",
+                      Patterns::Selection("kelly|kelly+contact"),
+                      "Adaptive: kelly, or kelly+contact, which also refines "
+                      "every cell at the active contact zone (one slave "
+                      "vertex spacing around it), where the pressure is "
+                      "resolved. Both sides of an interface are refined "
+                      "together.");
+    prm.leave_subsection();
+  }
+
+
+
+  void
+  Refinement::parse_parameters(ParameterHandler &prm)
+  {
+    prm.enter_subsection("Refinement");
+    n_cycles          = prm.get_integer("Number of cycles");
+    n_adaptive_cycles = prm.get_integer("Number of adaptive cycles");
+    if (n_adaptive_cycles == 0)
+      n_adaptive_cycles = n_cycles;
+    const std::string s = prm.get("Strategy");
+    strategy            = s == "global"     ? Strategy::global
+                          : s == "adaptive" ? Strategy::adaptive
+                                            : Strategy::compare;
+    refine_fraction     = prm.get_double("Refine fraction");
+    indicator           = prm.get("Indicator") == "kelly" ? Indicator::kelly
+                                                          : Indicator::kelly_contact;
+    prm.leave_subsection();
+  }
+
+
+
+  void
+  Refinement::refine(const Strategy                  strategy,
+                     Triangulation<2>               &triangulation,
+                     const DoFHandler<2>            &dof_handler,
+                     const Vector<double>           &solution,
+                     const Materials                &materials,
+                     const ContactInterfaces        &interfaces,
+                     const std::vector<ContactPair> &pairs,
+                     const ContactSolution          &contact) const
+  {
+    if (strategy == Strategy::global)
+      {
+        triangulation.refine_global(1);
+        return;
+      }
+    Vector<float> kelly(triangulation.n_active_cells());
+    KellyErrorEstimator<2>::estimate(elements::mapping(dof_handler),
+                                     dof_handler,
+                                     QGauss<1>(2),
+                                     {},
+                                     solution,
+                                     kelly);
+    for (const auto &cell : triangulation.active_cell_iterators())
+      kelly(cell->active_cell_index()) *=
+        std::sqrt(materials[cell->material_id()].youngs_modulus);
+    GridRefinement::refine_and_coarsen_fixed_fraction(triangulation,
+                                                      kelly,
+                                                      refine_fraction,
+                                                      0.);
+    if (indicator == Indicator::kelly_contact)
+      {
+        // The contact zone: within one slave spacing of an active pair, on
+        // either side.
+        std::vector<std::pair<Point<2>, double>> zone;
+        for (unsigned int p = 0; p < pairs.size(); ++p)
+          if (contact.active[p])
+            zone.emplace_back(pairs[p].position, 2 * pairs[p].length);
+        for (const auto &cell : triangulation.active_cell_iterators())
+          for (const unsigned int v : cell->vertex_indices())
+            for (const auto &[centre, radius] : zone)
+              if (cell->vertex(v).distance(centre) <= radius)
+                cell->set_refine_flag();
+      }
+    mark_partners(triangulation, interfaces);
+    triangulation.execute_coarsening_and_refinement();
+  }
+
+
+
+  void
+  Refinement::mark_partners(Triangulation<2>        &triangulation,
+                            const ContactInterfaces &interfaces) const
+  {
+    struct Side
+    {
+      Triangulation<2>::active_cell_iterator cell;
+      Point<2>                               centre;
+      double                                 length;
+    };
+    for (const auto &interface : interfaces.interfaces())
+      {
+        std::array<std::vector<Side>, 2> sides;
+        for (const auto &cell : triangulation.active_cell_iterators())
+          for (const auto &face : cell->face_iterators())
+            if (face->at_boundary())
+              for (unsigned int k = 0; k < 2; ++k)
+                if (face->boundary_id() ==
+                    (k == 0 ? interface.slave_id : interface.master_id))
+                  sides[k].push_back({cell, face->center(), face->measure()});
+        // Facing faces: centres closer than half the sum of their lengths.
+        // Found once through a grid as fine as the longest face (so only
+        // neighbouring grid cells can hold a partner), then swept until no
+        // flag changes: a marked face of length h becomes h/2, and a facing
+        // face longer than 0.75 h is marked too.
+        double h = 0;
+        for (const auto &side : sides)
+          for (const Side &face : side)
+            h = std::max(h, face.length);
+        std::map<std::pair<long, long>, std::vector<unsigned int>> grid;
+        const auto key = [h](const Point<2> &p) {
+          return std::make_pair(std::lround(std::floor(p[0] / h)),
+                                std::lround(std::floor(p[1] / h)));
+        };
+        for (unsigned int j = 0; j < sides[1].size(); ++j)
+          grid[key(sides[1][j].centre)].push_back(j);
+        std::vector<std::pair<unsigned int, unsigned int>> facing;
+        for (unsigned int i = 0; i < sides[0].size(); ++i)
+          {
+            const auto [x, y] = key(sides[0][i].centre);
+            for (long dx = -1; dx <= 1; ++dx)
+              for (long dy = -1; dy <= 1; ++dy)
+                {
+                  const auto it = grid.find({x + dx, y + dy});
+                  if (it != grid.end())
+                    for (const unsigned int j : it->second)
+                      if (sides[0][i].centre.distance(sides[1][j].centre) <
+                          0.5 * (sides[0][i].length + sides[1][j].length))
+                        facing.emplace_back(i, j);
+                }
+          }
+        for (bool changed = true; changed;)
+          {
+            changed = false;
+            for (const auto &[i, j] : facing)
+              for (unsigned int k = 0; k < 2; ++k)
+                {
+                  const Side &marked = k == 0 ? sides[0][i] : sides[1][j];
+                  const Side &other  = k == 0 ? sides[1][j] : sides[0][i];
+                  if (marked.cell->refine_flag_set() &&
+                      !other.cell->refine_flag_set() &&
+                      other.length > 0.75 * marked.length)
+                    {
+                      other.cell->set_refine_flag();
+                      changed = true;
+                    }
+                }
+          }
+      }
+  }
+
+
+
+  std::string
+  Refinement::name(const Strategy strategy)
+  {
+    return strategy == Strategy::global     ? "uniform"
+           : strategy == Strategy::adaptive ? "adaptive"
+                                            : "compare";
+  }
+} // namespace knee_contact

@@ -1,0 +1,177 @@
+#include <knee_contact/physics/elements.h>
+#include <knee_contact/postprocess/results.h>
+
+#include <deal.II/base/quadrature_lib.h>
+
+#include <deal.II/lac/affine_constraints.h>
+
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/fe/fe_values.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace knee_contact
+{
+  Results
+  compute_results(const DoFHandler<2>             &dof_handler,
+                  const std::vector<unsigned int> &body_of_cell,
+                  const SparseMatrix<double>      &matrix,
+                  const Vector<double>            &rhs,
+                  const Vector<double>            &solution,
+                  const Materials                 &materials,
+                  const BoundaryConditions        &boundary_conditions,
+                  const ContactInterfaces         &interfaces,
+                  const std::vector<ContactPair>  &pairs,
+                  const ContactSolution           &contact)
+  {
+    Results results;
+    results.n_dofs   = dof_handler.n_dofs();
+    results.n_cells  = dof_handler.get_triangulation().n_active_cells();
+    results.elements = elements::name(dof_handler.get_fe().reference_cell());
+    results.n_bodies =
+      body_of_cell.empty()
+        ? 0
+        : *std::max_element(body_of_cell.begin(), body_of_cell.end()) + 1;
+
+    // The force each dof's vertex receives from its supports: the
+    // residual d - C x of the unconstrained system minus the contact forces
+    // A^T lambda, with the sign of a reaction (C x = d + R - A^T lambda).
+    Vector<double> support_force(dof_handler.n_dofs());
+    matrix.vmult(support_force, solution);
+    support_force -= rhs;
+    for (unsigned int p = 0; p < pairs.size(); ++p)
+      for (const auto &[dof, a] : pairs[p].row)
+        support_force(dof) += a * contact.lambda[p];
+    // A hanging node's force belongs to the vertices it hangs from:
+    // apply the transpose of its constraint.
+    {
+      AffineConstraints<double> hanging;
+      DoFTools::make_hanging_node_constraints(dof_handler, hanging);
+      hanging.close();
+      for (const auto &line : hanging.get_lines())
+        {
+          for (const auto &[j, c] : line.entries)
+            support_force(j) += c * support_force(line.index);
+          support_force(line.index) = 0;
+        }
+    }
+    // a(u,u) = x^T C x, summed in a fixed order: SparseMatrix's own
+    // matrix_norm_square() is a threaded reduction whose last bit varies
+    // from run to run.
+    {
+      Vector<double> product(solution.size());
+      matrix.vmult(product, solution);
+      results.energy = 0;
+      for (unsigned int i = 0; i < solution.size(); ++i)
+        results.energy += solution(i) * product(i);
+    }
+    results.max_displacement = solution.linfty_norm();
+
+    // Applied load and reactions by vertex, each vertex once.
+    std::vector<bool> counted(dof_handler.n_dofs(), false);
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      for (const unsigned int v : cell->vertex_indices())
+        for (unsigned int d = 0; d < 2; ++d)
+          {
+            const auto dof = cell->vertex_dof_index(v, d);
+            if (!counted[dof])
+              results.applied_load[d] += rhs(dof);
+            counted[dof] = true;
+          }
+    // Each component goes to the condition that holds it: a displacement
+    // condition for its prescribed components first, then sliding.
+    std::fill(counted.begin(), counted.end(), false);
+    for (const bool sliding : {false, true})
+      for (const auto &condition : boundary_conditions.conditions())
+        if (condition.type ==
+            (sliding ? BoundaryType::sliding : BoundaryType::displacement))
+          for (const auto &cell : dof_handler.active_cell_iterators())
+            for (const auto &face : cell->face_iterators())
+              if (face->at_boundary() &&
+                  condition.ids.count(face->boundary_id()))
+                for (unsigned int v = 0; v < 2; ++v)
+                  for (unsigned int d = 0; d < 2; ++d)
+                    {
+                      const auto dof = face->vertex_dof_index(v, d);
+                      if (!counted[dof] && (sliding || condition.mask[d]))
+                        {
+                          results.reactions[face->boundary_id()][d] +=
+                            support_force(dof);
+                          counted[dof] = true;
+                        }
+                    }
+    // The force scale: the load, the reactions, or for a scene driven by
+    // prescribed displacements the force E max|u| that straining a body of
+    // unit size by max|u| takes.
+    Tensor<1, 2> balance = results.applied_load;
+    double       scale =
+      std::max(results.applied_load.norm(),
+               materials.max_youngs_modulus() * results.max_displacement);
+    for (const auto &reaction : results.reactions)
+      {
+        balance += reaction.second;
+        scale = std::max(scale, reaction.second.norm());
+      }
+    results.equilibrium_residual = scale > 0 ? balance.norm() / scale : 0;
+
+    // tau_yy at the vertices of every cell, as the pictures show it.
+    // (Q1: the trapezoidal rule's points are the vertices in deal.II's
+    // order; P1: the triangle's vertices. A triangle repeats its third
+    // vertex in the fourth entry, as cells.npy does.)
+    const ReferenceCell kind = dof_handler.get_fe().reference_cell();
+    FEValues<2>         fe_values(elements::mapping(dof_handler),
+                          dof_handler.get_fe(),
+                          kind.get_nodal_type_quadrature<2>(),
+                          update_gradients);
+    const unsigned int  n_vertices = kind.n_vertices();
+    std::vector<SymmetricTensor<2, 2>> strains(n_vertices);
+    const FEValuesExtractors::Vector   displacement(0);
+    results.vertex_stress_yy.resize(results.n_cells);
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      {
+        fe_values.reinit(cell);
+        fe_values[displacement].get_function_symmetric_gradients(solution,
+                                                                 strains);
+        const Material &material = materials[cell->material_id()];
+        auto            range    = results.stress_yy_range.emplace(
+          cell->material_id(),
+          std::make_pair(std::numeric_limits<double>::max(),
+                         -std::numeric_limits<double>::max()));
+        for (unsigned int v = 0; v < 4; ++v)
+          {
+            const double syy =
+              material.stress(strains[std::min(v, n_vertices - 1)])[1][1];
+            results.vertex_stress_yy[cell->active_cell_index()][v] = syy;
+            range.first->second.first =
+              std::min(range.first->second.first, syy);
+            range.first->second.second =
+              std::max(range.first->second.second, syy);
+          }
+      }
+
+    results.interfaces.resize(interfaces.interfaces().size());
+    for (unsigned int i = 0; i < results.interfaces.size(); ++i)
+      {
+        results.interfaces[i].name    = interfaces.interfaces()[i].name;
+        results.interfaces[i].pairing = interfaces.interfaces()[i].pairing;
+      }
+    results.pressure.resize(pairs.size());
+    for (unsigned int p = 0; p < pairs.size(); ++p)
+      {
+        InterfaceResult &r  = results.interfaces[pairs[p].interface];
+        results.pressure[p] = contact.lambda[p] / pairs[p].length;
+        ++r.n_pairs;
+        r.force += contact.lambda[p];
+        r.force_on_slave -= contact.lambda[p] * pairs[p].normal;
+        if (contact.active[p])
+          {
+            ++r.n_active;
+            r.contact_length += pairs[p].length;
+            r.max_pressure = std::max(r.max_pressure, results.pressure[p]);
+          }
+      }
+    return results;
+  }
+} // namespace knee_contact

@@ -1,0 +1,111 @@
+#include <knee_contact/postprocess/study.h>
+
+#include <deal.II/base/convergence_table.h>
+
+#include <cmath>
+#include <iomanip>
+
+namespace knee_contact
+{
+  namespace
+  {
+    // The errors a study reports, by column name.
+    const std::vector<std::pair<std::string, double Errors::*>> error_columns =
+      {{"L2 error", &Errors::l2_relative},
+       {"energy error", &Errors::energy_relative},
+       {"peak pressure error", &Errors::peak_pressure_relative},
+       {"contact length error", &Errors::contact_length_error},
+       {"pressure L2 error", &Errors::pressure_l2_relative},
+       {"energy vs reference", &Errors::energy_reference_relative},
+       {"extreme stress_yy error", &Errors::stress_extreme_relative}};
+  } // namespace
+
+
+
+  void
+  print_convergence_table(const std::vector<CycleRecord> &records,
+                          const bool                      with_times,
+                          std::ostream                   &out)
+  {
+    dealii::ConvergenceTable table;
+    for (const CycleRecord &r : records)
+      {
+        table.add_value("cycle", r.cycle);
+        table.add_value("dofs", r.n_dofs);
+        if (r.n_pairs > 0)
+          {
+            table.add_value("pairs", r.n_pairs);
+            table.add_value("iterations", r.n_iterations);
+            table.add_value("peak pressure", r.peak_pressure);
+            table.set_scientific("peak pressure", true);
+          }
+        for (const auto &[name, error] : error_columns)
+          if (!std::isnan(records.front().errors.*error))
+            {
+              table.add_value(name, r.errors.*error);
+              table.set_scientific(name, true);
+              table.set_precision(name, 3);
+            }
+        if (with_times)
+          {
+            table.add_value("time [s]", r.total_time);
+            table.add_value("memory [MB]", r.peak_memory);
+          }
+      }
+    if (records.size() > 1)
+      for (const auto &[name, error] : error_columns)
+        if (!std::isnan(records.front().errors.*error))
+          table.evaluate_convergence_rates(
+            name, "dofs", dealii::ConvergenceTable::reduction_rate_log2, 2);
+    out << records.front().strategy << " refinement:" << std::endl;
+    table.write_text(out);
+  }
+
+
+
+  void
+  write_study_csv(const std::vector<CycleRecord> &records, std::ostream &out)
+  {
+    out << "strategy,cycle,cells,dofs,pairs,iterations,peak_pressure,energy";
+    for (const auto &column : error_columns)
+      {
+        std::string name = column.first;
+        for (char &c : name)
+          if (c == ' ')
+            c = '_';
+        out << ',' << name;
+      }
+    const auto &phases = records.front().wall_time;
+    for (const auto &phase : phases)
+      out << ",time_" << phase.first;
+    const char *solver_columns[] = {"contact_solve",
+                                    "reference_solve",
+                                    "contact_unknowns",
+                                    "factor_memory_MB",
+                                    "dense_memory_MB"};
+    out << ",time_total,peak_memory_MB,solver";
+    for (const char *column : solver_columns)
+      out << ',' << column;
+    out << '\n' << std::setprecision(10);
+    for (const CycleRecord &r : records)
+      {
+        out << r.strategy << ',' << r.cycle << ',' << r.n_cells << ','
+            << r.n_dofs << ',' << r.n_pairs << ',' << r.n_iterations << ','
+            << r.peak_pressure << ',' << r.energy;
+        for (const auto &column : error_columns)
+          out << ',' << r.errors.*(column.second);
+        for (const auto &phase : phases)
+          {
+            const auto it = r.wall_time.find(phase.first);
+            out << ',' << (it == r.wall_time.end() ? 0. : it->second);
+          }
+        out << ',' << r.total_time << ',' << r.peak_memory << ',' << r.solver;
+        for (const char *column : solver_columns)
+          {
+            const auto it = r.solver_figures.find(column);
+            out << ',' << (it == r.solver_figures.end() ? 0. : it->second);
+          }
+        out << '\n';
+      }
+  }
+} // namespace knee_contact

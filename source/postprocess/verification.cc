@@ -1,0 +1,530 @@
+#include <knee_contact/physics/elements.h>
+#include <knee_contact/core/input.h>
+#include <knee_contact/postprocess/verification.h>
+
+#include <deal.II/base/quadrature_lib.h>
+
+#include <deal.II/fe/fe_values.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+
+namespace knee_contact
+{
+  void
+  Verification::declare_parameters(ParameterHandler &prm)
+  {
+    prm.enter_subsection("Verification");
+    prm.declare_entry("Exact displacement",
+                      "",
+                      Patterns::Anything(),
+                      "Reference u = (u_x; u_y) [m] in x, y: L2, energy and "
+                      "nodal errors are reported. Empty: none.");
+    prm.declare_entry("Exact stress",
+                      "",
+                      Patterns::Anything(),
+                      "Reference (tau_xx; tau_yy; tau_xy) [Pa]: the maximum "
+                      "error at the cells' Gauss points relative to the "
+                      "largest reference stress is checked against "
+                      "Tolerance. Empty: none.");
+    prm.declare_entry("Exact contact pressure",
+                      "",
+                      Patterns::Anything(),
+                      "Reference contact pressure [Pa] at the slave vertices: "
+                      "the maximum error relative to its largest value is "
+                      "checked against Tolerance. Empty: none.");
+    prm.declare_entry("Tolerance",
+                      "1e-10",
+                      Patterns::Double(0),
+                      "Tolerance of the exact-field checks (relative); the "
+                      "nodal displacement error is checked too when an "
+                      "exact displacement is given and Minimum L2 rate is 0.");
+    prm.declare_entry("Minimum L2 rate",
+                      "0",
+                      Patterns::Double(0),
+                      "With several refinement cycles: the smallest allowed "
+                      "observed L2 rate after the first refinement (h ~ "
+                      "n_dofs^-1/2); 0: no check.");
+    prm.declare_entry("Minimum energy rate",
+                      "0",
+                      Patterns::Double(0),
+                      "The same for the energy norm error.");
+    prm.declare_entry("Maximum L2 error",
+                      "0",
+                      Patterns::Double(0),
+                      "With an exact displacement: the largest allowed "
+                      "relative L2 error on the last mesh; 0: no check.");
+    prm.declare_entry("Minimum pressure rate",
+                      "0",
+                      Patterns::Double(0),
+                      "The same for the L2 error of the contact pressure "
+                      "over the slave sides against Exact contact pressure.");
+    prm.declare_entry("Check KKT",
+                      "true",
+                      Patterns::Bool(),
+                      "Check lambda >= 0, A x <= g (1e-10 of max |u|), "
+                      "complementarity and equilibrium (1e-8) when the scene "
+                      "has contact.");
+    prm.declare_entry("Reference peak pressure",
+                      "",
+                      Patterns::Anything(),
+                      "Constant expression for the expected largest contact "
+                      "pressure [Pa], e.g. a Hertz formula. Empty: none.");
+    prm.declare_entry("Peak pressure tolerance",
+                      "0.03",
+                      Patterns::Double(0),
+                      "Allowed relative error of the peak pressure.");
+    prm.declare_entry("Reference contact length",
+                      "",
+                      Patterns::Anything(),
+                      "Constant expression for the expected length of slave "
+                      "boundary in contact [m], summed over interfaces. "
+                      "Empty: none.");
+    prm.declare_entry("Contact length tolerance",
+                      "0",
+                      Patterns::Double(0),
+                      "Allowed absolute error of the contact length [m].");
+    prm.declare_entry("Reference energy",
+                      "",
+                      Patterns::Anything(),
+                      "Constant expression for a(u,u) [J/m] of an overkill "
+                      "solution: its relative error is checked against "
+                      "Energy tolerance. Empty: none.");
+    prm.declare_entry("Energy tolerance",
+                      "1e-3",
+                      Patterns::Double(0),
+                      "Allowed relative error of a(u,u) against Reference "
+                      "energy.");
+    prm.declare_entry("Reference extreme stress_yy",
+                      "",
+                      Patterns::Anything(),
+                      "'material name: value' [Pa]: the extreme (most "
+                      "negative if the value is negative, else largest) "
+                      "tau_yy in that material of an overkill solution; its "
+                      "relative error is checked against Extreme stress "
+                      "tolerance. Empty: none.");
+    prm.declare_entry("Extreme stress tolerance",
+                      "0.05",
+                      Patterns::Double(0),
+                      "Allowed relative error of that extreme tau_yy.");
+    prm.declare_entry("Reference contact forces",
+                      "",
+                      Patterns::Anything(),
+                      "Expected magnitude of the contact force on each "
+                      "interface's slave body [N/m]: 'interface name: "
+                      "constant expression; ...', e.g. the load a body held "
+                      "only by that interface carries.");
+    prm.declare_entry("Contact force tolerance",
+                      "1e-8",
+                      Patterns::Double(0),
+                      "Allowed relative error of those forces.");
+    prm.leave_subsection();
+  }
+
+
+
+  void
+  Verification::parse_parameters(ParameterHandler &prm)
+  {
+    prm.enter_subsection("Verification");
+    const auto optional = [&prm](const std::string &name,
+                                 const unsigned int n_components) {
+      const std::string text = prm.get(name);
+      return text.empty()
+               ? nullptr
+               : input::parse_expression(
+                   text, n_components, "Verification/" + name, "", true);
+    };
+    exact_displacement = optional("Exact displacement", 2);
+    exact_stress       = optional("Exact stress", 3);
+    exact_pressure     = optional("Exact contact pressure", 1);
+    tolerance          = prm.get_double("Tolerance");
+    min_l2_rate        = prm.get_double("Minimum L2 rate");
+    min_energy_rate    = prm.get_double("Minimum energy rate");
+    min_pressure_rate  = prm.get_double("Minimum pressure rate");
+    max_l2_error       = prm.get_double("Maximum L2 error");
+    check_kkt          = prm.get_bool("Check KKT");
+    if (!prm.get("Reference peak pressure").empty())
+      peak_pressure =
+        input::evaluate_constant(prm.get("Reference peak pressure"),
+                                 "Verification/Reference peak pressure");
+    peak_tolerance = prm.get_double("Peak pressure tolerance");
+    if (!prm.get("Reference contact length").empty())
+      contact_length =
+        input::evaluate_constant(prm.get("Reference contact length"),
+                                 "Verification/Reference contact length");
+    length_tolerance = prm.get_double("Contact length tolerance");
+    for (const auto &[name, value] :
+         input::split_named(prm.get("Reference contact forces"),
+                            "Verification/Reference contact forces",
+                            "name: value"))
+      interface_forces.emplace_back(
+        name,
+        input::evaluate_constant(value,
+                                 "Verification/Reference contact forces"));
+    force_tolerance = prm.get_double("Contact force tolerance");
+    if (!prm.get("Reference energy").empty())
+      reference_energy =
+        input::evaluate_constant(prm.get("Reference energy"),
+                                 "Verification/Reference energy");
+    energy_tolerance         = prm.get_double("Energy tolerance");
+    extreme_stress_tolerance = prm.get_double("Extreme stress tolerance");
+    for (const auto &[name, value] :
+         input::split_named(prm.get("Reference extreme stress_yy"),
+                            "Verification/Reference extreme stress_yy",
+                            "material name: value"))
+      {
+        AssertThrow(extreme_stress_material.empty(),
+                    ExcMessage("Verification/Reference extreme stress_yy: "
+                               "give one material, not several"));
+        extreme_stress_material = name;
+        extreme_stress =
+          input::evaluate_constant(value,
+                                   "Verification/Reference extreme stress_yy");
+      }
+    prm.leave_subsection();
+  }
+
+
+
+  Errors
+  Verification::compute_errors(const DoFHandler<2>            &dof_handler,
+                               const Vector<double>           &solution,
+                               const Materials                &materials,
+                               const std::vector<ContactPair> &pairs,
+                               const Results                  &results) const
+  {
+    Errors errors;
+    if (exact_displacement || exact_stress)
+      {
+        // Errors in L2, in the energy norm a(e, e)^1/2 and of the stress at
+        // Gauss points; the exact gradient comes from fourth order
+        // differences of the expression.
+        FEValues<2> fe_values(elements::mapping(dof_handler),
+                              dof_handler.get_fe(),
+                              elements::cell_quadrature(dof_handler, 3),
+                              update_values | update_gradients |
+                                update_quadrature_points | update_JxW_values);
+        const FEValuesExtractors::Vector   u(0);
+        const unsigned int                 n_q = fe_values.n_quadrature_points;
+        std::vector<Tensor<1, 2>>          values(n_q);
+        std::vector<SymmetricTensor<2, 2>> strains(n_q);
+        std::vector<Vector<double>>        exact_values(n_q, Vector<double>(2));
+        std::vector<std::vector<Tensor<1, 2>>> exact_gradients(
+          n_q, std::vector<Tensor<1, 2>>(2));
+        Vector<double> stress_values(3);
+        double         l2 = 0, l2_norm = 0, energy = 0, energy_norm = 0;
+        double         stress_error = 0, stress_max = 0;
+        for (const auto &cell : dof_handler.active_cell_iterators())
+          {
+            fe_values.reinit(cell);
+            fe_values[u].get_function_values(solution, values);
+            fe_values[u].get_function_symmetric_gradients(solution, strains);
+            const Material &material = materials[cell->material_id()];
+            if (exact_displacement)
+              {
+                exact_displacement->vector_value_list(
+                  fe_values.get_quadrature_points(), exact_values);
+                exact_displacement->vector_gradient_list(
+                  fe_values.get_quadrature_points(), exact_gradients);
+              }
+            for (unsigned int q = 0; q < n_q; ++q)
+              {
+                if (exact_displacement)
+                  {
+                    SymmetricTensor<2, 2> exact_strain;
+                    for (unsigned int i = 0; i < 2; ++i)
+                      for (unsigned int j = i; j < 2; ++j)
+                        exact_strain[i][j] = 0.5 * (exact_gradients[q][i][j] +
+                                                    exact_gradients[q][j][i]);
+                    Tensor<1, 2> exact;
+                    exact[0]                      = exact_values[q](0);
+                    exact[1]                      = exact_values[q](1);
+                    const SymmetricTensor<2, 2> e = strains[q] - exact_strain;
+                    l2 += (values[q] - exact).norm_square() * fe_values.JxW(q);
+                    l2_norm += exact.norm_square() * fe_values.JxW(q);
+                    energy += material.stress(e) * e * fe_values.JxW(q);
+                    energy_norm += material.stress(exact_strain) *
+                                   exact_strain * fe_values.JxW(q);
+                  }
+                if (exact_stress)
+                  {
+                    exact_stress->vector_value(fe_values.quadrature_point(q),
+                                               stress_values);
+                    const auto s = material.stress(strains[q]);
+                    stress_error =
+                      std::max({stress_error,
+                                std::abs(s[0][0] - stress_values(0)),
+                                std::abs(s[1][1] - stress_values(1)),
+                                std::abs(s[0][1] - stress_values(2))});
+                    stress_max = std::max({stress_max,
+                                           std::abs(stress_values(0)),
+                                           std::abs(stress_values(1)),
+                                           std::abs(stress_values(2))});
+                  }
+              }
+          }
+        if (exact_displacement)
+          {
+            errors.l2_relative     = std::sqrt(l2 / l2_norm);
+            errors.energy_relative = std::sqrt(energy / energy_norm);
+            // Nodal error at the vertices, relative to the largest value;
+            // the reference is evaluated a hair inside each cell, so that a
+            // reference that jumps between bodies in contact is taken from
+            // the vertex's own body.
+            double         nodal = 0, largest = 0;
+            Vector<double> exact(2);
+            for (const auto &cell : dof_handler.active_cell_iterators())
+              for (const unsigned int v : cell->vertex_indices())
+                {
+                  const Point<2> inside =
+                    cell->vertex(v) +
+                    1e-12 * (cell->center() - cell->vertex(v));
+                  exact_displacement->vector_value(inside, exact);
+                  for (unsigned int d = 0; d < 2; ++d)
+                    {
+                      nodal =
+                        std::max(nodal,
+                                 std::abs(
+                                   solution(cell->vertex_dof_index(v, d)) -
+                                   exact(d)));
+                      largest = std::max(largest, std::abs(exact(d)));
+                    }
+                }
+            // Absolute where the reference is zero everywhere.
+            errors.nodal_relative = nodal / (largest > 0 ? largest : 1.);
+          }
+        if (exact_stress)
+          errors.stress_relative = stress_error / stress_max;
+      }
+    if (exact_pressure && !pairs.empty())
+      {
+        double error = 0, largest = 0;
+        for (unsigned int p = 0; p < pairs.size(); ++p)
+          {
+            const double exact = exact_pressure->value(pairs[p].position);
+            error   = std::max(error, std::abs(results.pressure[p] - exact));
+            largest = std::max(largest, std::abs(exact));
+          }
+        errors.pressure_relative = error / largest;
+        double l2 = 0, norm = 0;
+        for (unsigned int p = 0; p < pairs.size(); ++p)
+          {
+            const double exact = exact_pressure->value(pairs[p].position);
+            l2 += pairs[p].length * std::pow(results.pressure[p] - exact, 2);
+            norm += pairs[p].length * exact * exact;
+          }
+        errors.pressure_l2_relative = std::sqrt(l2 / norm);
+      }
+    double max_pressure = 0, length = 0;
+    for (const auto &i : results.interfaces)
+      {
+        max_pressure = std::max(max_pressure, i.max_pressure);
+        length += i.contact_length;
+      }
+    if (peak_pressure != 0)
+      errors.peak_pressure_relative =
+        std::abs(max_pressure - peak_pressure) / peak_pressure;
+    if (contact_length != 0)
+      errors.contact_length_error = std::abs(length - contact_length);
+    if (reference_energy != 0)
+      errors.energy_reference_relative =
+        std::abs(results.energy - reference_energy) / reference_energy;
+    if (!extreme_stress_material.empty())
+      for (const auto &[id, range] : results.stress_yy_range)
+        if (materials[id].name == extreme_stress_material)
+          errors.stress_extreme_relative =
+            std::abs((extreme_stress < 0 ? range.first : range.second) -
+                     extreme_stress) /
+            std::abs(extreme_stress);
+    return errors;
+  }
+
+
+
+  double
+  Errors::primary() const
+  {
+    return std::isnan(peak_pressure_relative) ? energy_relative
+                                              : peak_pressure_relative;
+  }
+
+
+
+  unsigned int
+  Verification::check_study(const std::vector<Errors> &uniform_errors,
+                            const std::vector<double> &uniform_dofs,
+                            const std::vector<Errors> &adaptive_errors,
+                            const std::vector<double> &adaptive_dofs,
+                            std::ostream              &out) const
+  {
+    unsigned int n_failed = 0;
+    const auto   pass     = [&](const bool ok) {
+      n_failed += ok ? 0 : 1;
+      return ok ? "PASS" : "FAIL";
+    };
+    const unsigned int n = uniform_errors.size();
+    if (n >= 3)
+      {
+        const bool decreasing =
+          uniform_errors[n - 3].primary() > uniform_errors[n - 2].primary() &&
+          uniform_errors[n - 2].primary() > uniform_errors[n - 1].primary();
+        out << "check uniform error decreases over its last 3 cycles: "
+            << pass(decreasing) << std::endl;
+      }
+    const double target = uniform_errors.back().primary();
+    double       dofs   = std::numeric_limits<double>::infinity();
+    for (unsigned int k = 0; k < adaptive_errors.size(); ++k)
+      if (adaptive_errors[k].primary() <= target)
+        dofs = std::min(dofs, adaptive_dofs[k]);
+    const double ratio = dofs / uniform_dofs.back();
+    out << "check adaptive dofs to reach the finest uniform error / uniform "
+           "dofs: "
+        << std::scientific << std::setprecision(3) << ratio << std::defaultfloat
+        << " < 1: " << pass(ratio < 1) << std::endl;
+    return n_failed;
+  }
+
+
+
+  unsigned int
+  Verification::check(const Results             &results,
+                      const ContactSolution     &contact,
+                      const bool                 has_contact,
+                      const std::vector<Errors> &errors,
+                      const std::vector<double> &n_dofs,
+                      std::ostream              &out) const
+  {
+    unsigned int n_failed = 0;
+    const auto   report   = [&](const std::string &what,
+                            const double       value,
+                            const std::string &relation,
+                            const double       bound) {
+      const bool pass =
+        relation == "<=" ? value <= bound : value >= bound; // NaN fails
+      out << "check " << what << ": " << std::scientific << std::setprecision(3)
+          << value << ' ' << relation << ' ' << bound << std::defaultfloat
+          << ": " << (pass ? "PASS" : "FAIL") << std::endl;
+      n_failed += pass ? 0 : 1;
+    };
+
+    const Errors &last = errors.back();
+    if (exact_displacement && min_l2_rate == 0 && min_energy_rate == 0)
+      report("relative nodal displacement error",
+             last.nodal_relative,
+             "<=",
+             tolerance);
+    if (exact_stress)
+      report("relative stress error", last.stress_relative, "<=", tolerance);
+    if (exact_pressure)
+      report("relative contact pressure error",
+             last.pressure_relative,
+             "<=",
+             tolerance);
+
+    // Observed rates between successive cycles, h ~ n_dofs^(-1/2).
+    const auto min_rate = [&](double Errors::*error) {
+      double rate = std::numeric_limits<double>::max();
+      for (unsigned int k = 2; k < errors.size(); ++k)
+        rate = std::min(rate,
+                        std::log(errors[k - 1].*error / errors[k].*error) /
+                          (0.5 * std::log(n_dofs[k] / n_dofs[k - 1])));
+      return rate;
+    };
+    if (min_l2_rate > 0)
+      report("smallest L2 rate after the first refinement",
+             min_rate(&Errors::l2_relative),
+             ">=",
+             min_l2_rate);
+    if (min_energy_rate > 0)
+      report("smallest energy rate after the first refinement",
+             min_rate(&Errors::energy_relative),
+             ">=",
+             min_energy_rate);
+    if (max_l2_error > 0)
+      report("relative L2 error on the last mesh",
+             last.l2_relative,
+             "<=",
+             max_l2_error);
+    if (min_pressure_rate > 0)
+      report("smallest contact pressure L2 rate after the first refinement",
+             min_rate(&Errors::pressure_l2_relative),
+             ">=",
+             min_pressure_rate);
+
+    if (has_contact && check_kkt)
+      {
+        double max_pressure = 0, min_pressure = 0;
+        for (const double p : results.pressure)
+          {
+            max_pressure = std::max(max_pressure, p);
+            min_pressure = std::min(min_pressure, p);
+          }
+        report("converged", contact.converged ? 1 : 0, ">=", 1);
+        report("lambda >= 0: -min pressure / max pressure",
+               max_pressure > 0 ? -min_pressure / max_pressure : 0,
+               "<=",
+               1e-10);
+        report("A x <= g: max penetration / max |u|",
+               results.max_displacement > 0
+                 ? std::max(contact.max_penetration, 0.) /
+                     results.max_displacement
+                 : 0,
+               "<=",
+               1e-10);
+        report(
+          "complementarity residual", contact.complementarity, "<=", 1e-10);
+        report(
+          "equilibrium residual", results.equilibrium_residual, "<=", 1e-8);
+      }
+    if (peak_pressure != 0)
+      report("relative error of the peak pressure",
+             last.peak_pressure_relative,
+             "<=",
+             peak_tolerance);
+    if (contact_length != 0)
+      report("error of the contact length [m]",
+             last.contact_length_error,
+             "<=",
+             length_tolerance);
+    if (reference_energy != 0)
+      report("relative error of the energy a(u,u)",
+             last.energy_reference_relative,
+             "<=",
+             energy_tolerance);
+    if (!extreme_stress_material.empty())
+      report("relative error of the extreme tau_yy in '" +
+               extreme_stress_material + "'",
+             last.stress_extreme_relative,
+             "<=",
+             extreme_stress_tolerance);
+    for (const auto &[name, force] : interface_forces)
+      {
+        const auto it = std::find_if(results.interfaces.begin(),
+                                     results.interfaces.end(),
+                                     [&](const InterfaceResult &i) {
+                                       return i.name == name;
+                                     });
+        AssertThrow(it != results.interfaces.end(),
+                    ExcMessage("Verification/Reference contact forces: no "
+                               "contact interface named '" +
+                               name + "'"));
+        report("relative error of the contact force on '" + name + "'",
+               std::abs(it->force_on_slave.norm() - force) / force,
+               "<=",
+               force_tolerance);
+      }
+    return n_failed;
+  }
+
+
+  void
+  Verification::set_load_parameter(const double t)
+  {
+    for (auto *function :
+         {exact_displacement.get(), exact_stress.get(), exact_pressure.get()})
+      if (function != nullptr)
+        function->set_time(t);
+  }
+} // namespace knee_contact

@@ -1,0 +1,530 @@
+#include <knee_contact/solver/active_set.h>
+
+#include <deal.II/lac/dynamic_sparsity_pattern.h>
+#include <deal.II/lac/sparse_direct.h>
+#include <deal.II/lac/sparsity_pattern.h>
+
+#include <deal.II/dofs/dof_tools.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <iomanip>
+#include <limits>
+#include <map>
+#include <set>
+#include <stdexcept>
+#include <string>
+
+namespace knee_contact
+{
+  void
+  ActiveSetSolver::declare_parameters(ParameterHandler &prm)
+  {
+    prm.enter_subsection("Contact");
+    prm.declare_entry("Maximum active set iterations",
+                      "50",
+                      Patterns::Integer(1),
+                      "Stop with converged = false after this many "
+                      "iterations.");
+    prm.declare_entry("Active set constant",
+                      "100",
+                      Patterns::Double(0),
+                      "c of the active-set test lambda_p + c ((A x)_p - "
+                      "g_p) > 0, in units of the largest Young's modulus "
+                      "(step-42 uses 100 E).");
+    prm.declare_entry("Tolerance",
+                      "1e-10",
+                      Patterns::Double(0),
+                      "Converged when the active set repeats and the "
+                      "relative complementarity residual max_p |min(lambda_p "
+                      "/ max lambda, (g_p - (A x)_p) / max |u|)| is below "
+                      "this (max |u| over the contact unknowns).");
+    prm.declare_entry("Cycle safeguard",
+                      "true",
+                      Patterns::Bool(),
+                      "When the active set returns to an earlier set, go on "
+                      "releasing at most one pair per iteration (the most "
+                      "negative lambda) while adding every penetrating pair; "
+                      "false: stop with converged = false.");
+    prm.declare_entry("Solver",
+                      "automatic",
+                      Patterns::Selection("automatic|condensed|sparse|step-41"),
+                      "automatic: estimate the time and memory of the "
+                      "condensed and sparse paths before allocating and take "
+                      "the cheaper that fits (the log and summary.json say "
+                      "which and why); condensed: factorise once per mesh "
+                      "with the contact unknowns last and run the loop on "
+                      "their dense Schur complement (cheapest where the "
+                      "contact unknowns are few); sparse: one CHOLMOD "
+                      "analysis per mesh, one numeric factorisation per "
+                      "active set (memory of the sparse factor only); "
+                      "step-41: condense and factorise the whole system "
+                      "with UMFPACK in every iteration (the first "
+                      "version's path, kept for comparison).");
+    prm.declare_entry("Reference solve",
+                      "false",
+                      Patterns::Bool(),
+                      "After the contact solve, time one linear solve of the "
+                      "same system with the final active set held fixed "
+                      "(CHOLMOD, METIS ordering: the fastest linear solver "
+                      "of the project) and compare its solution; the "
+                      "benchmark's reference.");
+    prm.leave_subsection();
+  }
+
+
+
+  void
+  ActiveSetSolver::parse_parameters(ParameterHandler &prm,
+                                    const double      max_youngs_modulus)
+  {
+    prm.enter_subsection("Contact");
+    max_iterations = prm.get_integer("Maximum active set iterations");
+    c              = prm.get_double("Active set constant") * max_youngs_modulus;
+    tolerance      = prm.get_double("Tolerance");
+    safeguard      = prm.get_bool("Cycle safeguard");
+    reference_solve        = prm.get_bool("Reference solve");
+    const std::string path = prm.get("Solver");
+    solver                 = path == "step-41"     ? LinearSolver::step41
+                             : path == "sparse"    ? LinearSolver::sparse
+                             : path == "condensed" ? LinearSolver::condensed
+                                                   : LinearSolver::automatic;
+    AssertThrow(c > 0, ExcMessage("Contact/Active set constant must be > 0"));
+    prm.leave_subsection();
+  }
+
+
+
+  void
+  ActiveSetSolver::make_constraints(const AffineConstraints<double> &base,
+                                    const std::vector<ContactPair>  &pairs,
+                                    const std::vector<bool>         &active,
+                                    AffineConstraints<double> &constraints)
+  {
+    // An active row a'_p . x = g'_p over dofs free of Gamma_u/Gamma_o, solved
+    // for the eliminated dof j: x_j = (g'_p - sum_{k != j} a'_pk x_k) / a'_pj.
+    constraints.clear();
+    for (unsigned int p = 0; p < pairs.size(); ++p)
+      if (active[p])
+        {
+          const ContactPair &pair = pairs[p];
+          double             a_j  = 0;
+          for (const auto &[dof, a] : pair.reduced_row)
+            if (dof == pair.eliminated)
+              a_j = a;
+          constraints.add_line(pair.eliminated);
+          for (const auto &[dof, a] : pair.reduced_row)
+            if (dof != pair.eliminated)
+              constraints.add_entry(pair.eliminated, dof, -a / a_j);
+          constraints.set_inhomogeneity(pair.eliminated,
+                                        pair.reduced_gap / a_j);
+        }
+    constraints.merge(
+      base, AffineConstraints<double>::MergeConflictBehavior::left_object_wins);
+    constraints.close();
+  }
+
+
+
+  std::vector<double>
+  ActiveSetSolver::multipliers(const Vector<double>            &residual,
+                               const AffineConstraints<double> &base,
+                               const std::vector<ContactPair>  &pairs,
+                               const std::vector<bool>         &active)
+  {
+    // Equations at the eliminated dofs j_p of the active pairs:
+    //   sum_q lambda_q a'_q(j_p) = (C0^T r)(j_p),
+    // (C0^T r)(j) = r_j + sum over Gamma_u/Gamma_o lines x_i = c_ij x_j + ..
+    // of c_ij r_i. The matrix is the identity up to scaling unless rows
+    // share eliminated dofs, so this small sparse solve is cheap.
+    std::vector<unsigned int>                   index(pairs.size());
+    std::map<types::global_dof_index, unsigned> equation_of_dof;
+    unsigned int                                n = 0;
+    for (unsigned int p = 0; p < pairs.size(); ++p)
+      if (active[p])
+        {
+          index[p]                             = n;
+          equation_of_dof[pairs[p].eliminated] = n++;
+        }
+    std::vector<double> lambda(pairs.size(), 0.);
+    if (n == 0)
+      return lambda;
+
+    Vector<double> b(n);
+    for (const auto &[dof, e] : equation_of_dof)
+      b(e) = residual(dof);
+    for (const auto &line : base.get_lines())
+      for (const auto &[j, c] : line.entries)
+        {
+          const auto it = equation_of_dof.find(j);
+          if (it != equation_of_dof.end())
+            b(it->second) += c * residual(line.index);
+        }
+
+    DynamicSparsityPattern dsp(n, n);
+    for (unsigned int p = 0; p < pairs.size(); ++p)
+      if (active[p])
+        for (const auto &entry : pairs[p].reduced_row)
+          {
+            const auto it = equation_of_dof.find(entry.first);
+            if (it != equation_of_dof.end())
+              dsp.add(it->second, index[p]);
+          }
+    SparsityPattern sparsity;
+    sparsity.copy_from(dsp);
+    SparseMatrix<double> matrix(sparsity);
+    for (unsigned int p = 0; p < pairs.size(); ++p)
+      if (active[p])
+        for (const auto &[dof, a] : pairs[p].reduced_row)
+          {
+            const auto it = equation_of_dof.find(dof);
+            if (it != equation_of_dof.end())
+              matrix.add(it->second, index[p], a);
+          }
+    SparseDirectUMFPACK solver;
+    solver.initialize(matrix);
+    solver.solve(b);
+    for (unsigned int p = 0; p < pairs.size(); ++p)
+      if (active[p])
+        lambda[p] = b(index[p]);
+    return lambda;
+  }
+
+
+
+  void
+  ActiveSetSolver::make_sparsity_pattern(const DoFHandler<2> &dof_handler,
+                                         const AffineConstraints<double> &base,
+                                         const std::vector<ContactPair>  &pairs,
+                                         SparsityPattern &sparsity_pattern)
+  {
+    // One sparsity pattern serves every active set. Condensing a set of
+    // lines couples each dof i with the dofs its line refers to after
+    // chains are resolved, and which chains exist depends on the active set
+    // (a hanging node refers to a slave dof, which refers to master dofs
+    // only while its pair is active). So E(i) is the transitive closure of
+    // the one-level entries R(i) (Gamma_u/Gamma_o/hanging-node line, or the
+    // reduced row of the pair eliminating i), and an entry (i, j) of the
+    // mesh's pattern needs E(i) x E(j).
+    std::map<types::global_dof_index, std::set<types::global_dof_index>>
+      one_level;
+    for (const auto &line : base.get_lines())
+      for (const auto &entry : line.entries)
+        one_level[line.index].insert(entry.first);
+    for (const auto &pair : pairs)
+      if (pair.eliminated != numbers::invalid_dof_index)
+        for (const auto &entry : pair.reduced_row)
+          if (entry.first != pair.eliminated)
+            one_level[pair.eliminated].insert(entry.first);
+    std::map<types::global_dof_index, std::vector<types::global_dof_index>>
+                                      expansion;
+    std::set<types::global_dof_index> in_progress;
+    const std::function<const std::vector<types::global_dof_index> &(
+      types::global_dof_index)>
+      closure = [&](const types::global_dof_index i)
+      -> const std::vector<types::global_dof_index> & {
+      const auto known = expansion.find(i);
+      if (known != expansion.end())
+        return known->second;
+      // Lines that refer to each other in a cycle cannot be constraints; the
+      // elimination in make_pairs() is meant to prevent it.
+      if (!in_progress.insert(i).second)
+        throw std::logic_error("the contact rows eliminate dofs that refer "
+                               "to each other in a cycle (dof " +
+                               std::to_string(i) + ")");
+      std::set<types::global_dof_index> dofs = {i};
+      const auto                        it   = one_level.find(i);
+      if (it != one_level.end())
+        for (const auto e : it->second)
+          {
+            const auto &sub = closure(e);
+            dofs.insert(sub.begin(), sub.end());
+          }
+      return expansion[i] =
+               std::vector<types::global_dof_index>(dofs.begin(), dofs.end());
+    };
+    for (const auto &entry : one_level)
+      closure(entry.first);
+
+    DynamicSparsityPattern mesh_pattern(dof_handler.n_dofs());
+    DoFTools::make_sparsity_pattern(dof_handler, mesh_pattern);
+    DynamicSparsityPattern dsp(dof_handler.n_dofs());
+    for (types::global_dof_index i = 0; i < dof_handler.n_dofs(); ++i)
+      {
+        const auto ei = expansion.find(i);
+        for (auto it = mesh_pattern.begin(i); it != mesh_pattern.end(i); ++it)
+          {
+            const types::global_dof_index j  = it->column();
+            const auto                    ej = expansion.find(j);
+            if (ei == expansion.end() && ej == expansion.end())
+              dsp.add(i, j);
+            else
+              for (const auto a : ei == expansion.end()
+                                    ? std::vector<types::global_dof_index>{i}
+                                    : ei->second)
+                for (const auto b : ej == expansion.end()
+                                      ? std::vector<types::global_dof_index>{j}
+                                      : ej->second)
+                  dsp.add(a, b);
+          }
+      }
+    sparsity_pattern.copy_from(dsp);
+  }
+
+
+
+  FullContactSystem::FullContactSystem(const SparseMatrix<double>      &matrix,
+                                       const AffineConstraints<double> &base,
+                                       const std::vector<ContactPair>  &pairs)
+    : matrix(matrix)
+    , base(base)
+    , pairs(pairs)
+    , system_matrix(matrix.get_sparsity_pattern())
+    , system_rhs(matrix.m())
+    , x(matrix.m())
+  {}
+
+
+
+  void
+  FullContactSystem::set_rhs(const Vector<double> &new_rhs)
+  {
+    rhs = &new_rhs;
+  }
+
+
+
+  void
+  FullContactSystem::solve(const std::vector<bool> &active,
+                           std::vector<double>     &excess,
+                           std::vector<double>     &lambda)
+  {
+    AffineConstraints<double> constraints;
+    ActiveSetSolver::make_constraints(base, pairs, active, constraints);
+    Assert(rhs != nullptr, ExcMessage("set_rhs() was not called"));
+    system_matrix.copy_from(matrix);
+    system_rhs = *rhs;
+    constraints.condense(system_matrix, system_rhs);
+    SparseDirectUMFPACK direct;
+    direct.initialize(system_matrix);
+    direct.vmult(x, system_rhs);
+    constraints.distribute(x);
+
+    ActiveSetSolver::excess_and_multipliers(
+      matrix, *rhs, x, base, pairs, active, excess, lambda);
+  }
+
+
+
+  double
+  FullContactSystem::displacement_scale() const
+  {
+    return ActiveSetSolver::displacement_scale(pairs, x);
+  }
+
+
+
+  void
+  ActiveSetSolver::excess_and_multipliers(const SparseMatrix<double> &matrix,
+                                          const Vector<double>       &rhs,
+                                          const Vector<double>       &x,
+                                          const AffineConstraints<double> &base,
+                                          const std::vector<ContactPair> &pairs,
+                                          const std::vector<bool> &active,
+                                          std::vector<double>     &excess,
+                                          std::vector<double>     &lambda)
+  {
+    Vector<double> residual(rhs.size());
+    matrix.residual(residual, x, rhs);
+    lambda = multipliers(residual, base, pairs, active);
+    excess.resize(pairs.size());
+    for (unsigned int p = 0; p < pairs.size(); ++p)
+      excess[p] = pairs[p].jump(x) - pairs[p].gap;
+  }
+
+
+
+  double
+  ActiveSetSolver::displacement_scale(const std::vector<ContactPair> &pairs,
+                                      const Vector<double>           &x)
+  {
+    // Over the contact unknowns, as the condensed path sees them.
+    double scale = 0;
+    for (const auto &pair : pairs)
+      if (pair.eliminated != numbers::invalid_dof_index)
+        for (const auto &entry : pair.reduced_row)
+          scale = std::max(scale, std::abs(x(entry.first)));
+    return scale;
+  }
+
+
+
+  void
+  FullContactSystem::solution(Vector<double> &result)
+  {
+    result = x;
+  }
+
+
+
+  ContactSolution
+  ActiveSetSolver::solve(ContactSystem                   &system,
+                         const double                     force_scale_of_load,
+                         const AffineConstraints<double> &base,
+                         const std::vector<ContactPair>  &pairs,
+                         const RigidModes                &rigid_modes,
+                         const std::vector<bool>         &guess,
+                         std::ostream                    &log) const
+  {
+    const unsigned int n_pairs = pairs.size();
+    ContactSolution    result;
+    // Start from the guess (the previous load case's or mesh's contact
+    // zone) if there is one, else from the pairs that touch (g_p <= 0). A
+    // body that
+    // only contact holds (a floating femur, a mobile insert) may need more:
+    // close the smallest gaps first, doubling their number, until every body is
+    // held. The loop below releases any of them whose multiplier is negative.
+    result.active.assign(n_pairs, false);
+    std::vector<unsigned int> by_gap;
+    for (unsigned int p = 0; p < n_pairs; ++p)
+      if (pairs[p].eliminated != numbers::invalid_dof_index)
+        {
+          if (guess.empty() ? pairs[p].gap <= 0 : bool(guess[p]))
+            result.active[p] = true;
+          else
+            by_gap.push_back(p);
+        }
+    std::stable_sort(by_gap.begin(),
+                     by_gap.end(),
+                     [&pairs](const unsigned int a, const unsigned int b) {
+                       return pairs[a].gap < pairs[b].gap;
+                     });
+    for (std::size_t closed = 0;
+         closed < by_gap.size() &&
+         !rigid_modes.free_motion(base, pairs, result.active).empty();)
+      {
+        const std::size_t next = std::min(by_gap.size(), 2 * closed + 1);
+        for (; closed < next; ++closed)
+          result.active[by_gap[closed]] = true;
+      }
+
+    std::set<std::vector<bool>> seen;
+    std::vector<double>         excesses;
+
+    for (unsigned int iteration = 1;; ++iteration)
+      {
+        rigid_modes.check(
+          base,
+          pairs,
+          result.active,
+          iteration == 1
+            ? "add a displacement or sliding boundary, or bring it into "
+              "contact (zero gap)"
+            : "at active-set iteration " + std::to_string(iteration) +
+                " its load pulls it off its contact pairs");
+
+        system.solve(result.active, excesses, result.lambda);
+
+        // The active-set test of step-41, and the NCP residual
+        // |min(lambda_p, g_p - (A x)_p)| scaled by max lambda and max |u|.
+        double lambda_scale = 0;
+        for (const double l : result.lambda)
+          lambda_scale = std::max(lambda_scale, std::abs(l));
+        const double u_scale = std::max(system.displacement_scale(), 1e-300);
+        if (lambda_scale == 0)
+          lambda_scale = 1;
+        const double      force_scale = force_scale_of_load + lambda_scale;
+        std::vector<bool> next(n_pairs, false);
+        unsigned int      n_entered = 0, n_left = 0, n_active = 0;
+        result.complementarity = 0;
+        result.max_penetration = -std::numeric_limits<double>::max();
+        for (unsigned int p = 0; p < n_pairs; ++p)
+          {
+            const double excess    = excesses[p];
+            result.max_penetration = std::max(result.max_penetration, excess);
+            result.complementarity =
+              std::max(result.complementarity,
+                       std::abs(std::min(result.lambda[p] / lambda_scale,
+                                         -excess / u_scale)));
+            // An active pair stays while lambda_p >= 0 up to round-off: an
+            // unloaded contact (lambda = 0, zero load) is a solution, and
+            // the strict test would release a body that only contact holds.
+            next[p] =
+              pairs[p].eliminated != numbers::invalid_dof_index &&
+              (result.lambda[p] + c * excess > 0 ||
+               (result.active[p] && result.lambda[p] >= -1e-12 * force_scale));
+            n_active += next[p];
+            n_entered += next[p] && !result.active[p];
+            n_left += !next[p] && result.active[p];
+          }
+        // Safeguard after a cycle: of the pairs the test releases, release
+        // only the one with the most negative multiplier.
+        const auto release_one = [&]() {
+          unsigned int release = numbers::invalid_unsigned_int;
+          for (unsigned int p = 0; p < n_pairs; ++p)
+            if (result.active[p] && !next[p] &&
+                (release == numbers::invalid_unsigned_int ||
+                 result.lambda[p] < result.lambda[release]))
+              release = p;
+          for (unsigned int p = 0; p < n_pairs; ++p)
+            if (result.active[p] && !next[p] && p != release)
+              {
+                next[p] = true;
+                ++n_active;
+                --n_left;
+              }
+        };
+        if (result.safeguard_from > 0)
+          release_one();
+        result.n_iterations = iteration;
+        log << "   active set iteration " << std::setw(2) << iteration << ": "
+            << std::setw(5) << n_active << " active pairs (+" << n_entered
+            << " -" << n_left << "), complementarity residual "
+            << std::scientific << std::setprecision(2) << result.complementarity
+            << std::defaultfloat << std::endl;
+
+        if (next == result.active && result.complementarity <= tolerance)
+          return result;
+        if (next == result.active)
+          {
+            result.converged = false;
+            result.failure   = "the active set settled but the "
+                               "complementarity residual stays above "
+                               "Contact/Tolerance";
+            return result;
+          }
+        if (seen.count(next) && safeguard && result.safeguard_from == 0)
+          {
+            // Switch the safeguard on and forget the history: from here on
+            // the set changes by one release at a time.
+            result.safeguard_from = iteration;
+            log << "   active set cycle at iteration " << iteration
+                << ": releasing at most one pair per iteration from now on"
+                << std::endl;
+            seen.clear();
+            release_one();
+          }
+        if (seen.count(next))
+          {
+            result.converged = false;
+            result.failure =
+              "the active set cycles (iteration " + std::to_string(iteration) +
+              " returns to an earlier set); make the finer side the slave, "
+              "or refine the coarse side of the interface";
+            return result;
+          }
+        if (iteration >= max_iterations)
+          {
+            result.converged = false;
+            result.failure =
+              "no convergence in " + std::to_string(max_iterations) +
+              " active-set iterations; raise 'Maximum active set "
+              "iterations' or refine the contact zone";
+            return result;
+          }
+        seen.insert(result.active);
+        result.active = next;
+      }
+  }
+} // namespace knee_contact

@@ -1,0 +1,305 @@
+#include <knee_contact/solver/contact_system.h>
+#include <knee_contact/solver/sparse_cholesky.h>
+
+#include <deal.II/base/timer.h>
+
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <limits>
+#include <set>
+#include <sstream>
+#include <string>
+
+namespace knee_contact
+{
+  namespace
+  {
+    /** The first number after @p key in @p file [bytes], or -1. */
+    double
+    read_field(const std::string &file, const std::string &key, double unit)
+    {
+      std::ifstream in(file);
+      std::string   line;
+      while (std::getline(in, line))
+        if (line.compare(0, key.size(), key) == 0)
+          {
+            std::istringstream fields(line.substr(key.size()));
+            double             value = -1;
+            if (fields >> value)
+              return value * unit;
+          }
+      return -1;
+    }
+
+    /** A file holding one number ("max": no limit) [bytes], or -1. */
+    double
+    read_number(const std::string &file)
+    {
+      std::ifstream in(file);
+      std::string   word;
+      if (!(in >> word) || word == "max")
+        return -1;
+      try
+        {
+          return std::stod(word);
+        }
+      catch (...)
+        {
+          return -1;
+        }
+    }
+
+    /**
+     * Bytes this process can still allocate before the kernel refuses or
+     * kills it: the least of MemAvailable, the cgroup's limit (v2 or v1)
+     * less its usage, and the address-space limit (ulimit -v) less the
+     * process's mapped size. @p which names the binding limit.
+     */
+    double
+    available_memory(std::string &which)
+    {
+      double available = std::numeric_limits<double>::max();
+      which            = "no limit found";
+      const auto take  = [&](const double value, const std::string &name) {
+        if (value >= 0 && value < available)
+          {
+            available = value;
+            which     = name;
+          }
+      };
+      take(read_field("/proc/meminfo", "MemAvailable:", 1024.), "MemAvailable");
+      for (const auto &[limit, usage] :
+           {std::pair<std::string, std::string>{
+              "/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"},
+            {"/sys/fs/cgroup/memory/memory.limit_in_bytes",
+             "/sys/fs/cgroup/memory/memory.usage_in_bytes"}})
+        {
+          const double max = read_number(limit), used = read_number(usage);
+          if (max >= 0 && max < 1e18 && used >= 0)
+            take(std::max(0., max - used), "the cgroup's memory limit");
+        }
+      rlimit address_space;
+      if (getrlimit(RLIMIT_AS, &address_space) == 0 &&
+          address_space.rlim_cur != RLIM_INFINITY)
+        {
+          const double mapped =
+            read_field("/proc/self/status", "VmSize:", 1024.);
+          take(std::max(0., double(address_space.rlim_cur) - mapped),
+               "the address-space limit (ulimit -v)");
+        }
+      return available;
+    }
+
+    std::string
+    megabytes(const double bytes)
+    {
+      std::ostringstream out;
+      out << std::fixed << std::setprecision(0) << bytes / 1048576. << " MB";
+      return out.str();
+    }
+
+    std::string
+    gigaflops(const double flops)
+    {
+      std::ostringstream out;
+      out << std::setprecision(3) << flops / 1e9 << " Gflop";
+      return out.str();
+    }
+  } // namespace
+
+
+
+  std::string
+  solver_path_name(const SolverPath path)
+  {
+    switch (path)
+      {
+        case SolverPath::automatic:
+          return "automatic";
+        case SolverPath::condensed:
+          return "condensed";
+        case SolverPath::sparse:
+          return "sparse";
+        case SolverPath::step41:
+          return "step-41";
+      }
+    return "";
+  }
+
+
+
+  std::unique_ptr<ContactSystem>
+  make_contact_system(const SolverPath                 requested,
+                      const SparseMatrix<double>      &matrix,
+                      const AffineConstraints<double> &base,
+                      const std::vector<ContactPair>  &pairs,
+                      const bool                       warm_start,
+                      std::ostream                    &log,
+                      std::string                     &name,
+                      std::map<std::string, double>   &figures)
+  {
+    if (requested == SolverPath::step41)
+      {
+        // The first version's path, kept for comparison: UMFPACK's memory
+        // is not known before its factorisation, so it is not estimated.
+        name = "step-41";
+        return std::make_unique<FullContactSystem>(matrix, base, pairs);
+      }
+
+    // Sizes of the condensed path: k contact unknowns (every free dof of
+    // a row that can be active), P rows.
+    std::set<types::global_dof_index> contact;
+    double                            n_rows = 0;
+    for (const auto &pair : pairs)
+      if (pair.eliminated != numbers::invalid_dof_index)
+        {
+          ++n_rows;
+          for (const auto &entry : pair.reduced_row)
+            contact.insert(entry.first);
+        }
+    const double k = contact.size(), P = n_rows;
+
+    // The sparse path's ordering and symbolic analysis are needed for its
+    // estimate and are its own first step; the condensed path reuses the
+    // ordering with the contact unknowns moved last.
+    auto sparse = std::make_unique<SparseContactSystem>(matrix, base, pairs);
+    const double lnz      = sparse->nnz_factor();
+    const double fl       = sparse->flops();
+    const auto  &sparsity = matrix.get_sparsity_pattern();
+    const double nnz_lower =
+      (sparsity.n_nonzero_elements() + sparsity.n_rows()) / 2.;
+
+    // Iterations the loop is expected to take: measured 1-5 from a guess
+    // (a refined mesh's or load case's contact zone), up to 17 cold
+    // (scripts/benchmark.py); each costs the condensed path one P x P LU.
+    const double iterations = warm_start ? 3 : 10;
+
+    // Peak memory beyond what is allocated now [bytes]: the factor's values
+    // and indices (about 1.2 x 8 bytes per entry measured), CHOLMOD's copy of
+    // the matrix (lower triangle, 12 bytes per entry), the condensed copy
+    // (all entries of the pattern, 12 bytes each); the sparse path's
+    // bordered-update vectors may take as much as its factor; the condensed
+    // path adds L_cc, S, S~ (k^2 each), W (k P), G and its LU (P^2 each) and
+    // its factor holds the dense k x k trailing block.
+    const double matrix_bytes =
+      12. * nnz_lower + 12. * sparsity.n_nonzero_elements();
+    const double sparse_bytes    = 2 * 9.6 * lnz + matrix_bytes;
+    const double condensed_bytes = 9.6 * (lnz + k * k / 2) + matrix_bytes +
+                                   8. * (3 * k * k + k * P + 2 * P * P);
+    // Work [flops]: the condensed path factorises once (the trailing block
+    // adds k^3/3), forms S (k^3), factorises S~ (k^3/3), W (2 k^2 P) and per
+    // iteration the P x P LU (2/3 P^3).
+    // Dense BLAS-3 runs about 4x the flop rate of a supernodal factorisation
+    // of a 2D mesh on this machine kind (measured: potrf/syrk at k = 5 000
+    // 15-20 Gflop/s, CHOLMOD 2-5 Gflop/s), so dense flops count a quarter.
+    const double condensed_flops =
+      fl + 0.25 * (k * k * k * (1. / 3 + 1 + 1. / 3) + 2 * k * k * P +
+                   iterations * 2. / 3 * P * P * P);
+    // The sparse path refactorises only when an active set differs from its
+    // factor's in more rows than a factorisation's worth of solves: from a
+    // guess one factorisation and a few solves (measured 1.1-1.3
+    // factorisations), cold about two per three iterations (knee, 1.1e5
+    // dofs: 9 factorisations and 31 update solves in 14 iterations).
+    const double sparse_flops = (warm_start ? 1.3 : 0.65 * iterations) * fl;
+
+    std::string  limit;
+    const double available = available_memory(limit);
+    // Head room for the solution vectors and the results that follow.
+    const auto fits = [&](const double bytes) {
+      return bytes <= 0.8 * available;
+    };
+    figures["estimated_sparse_MB"]       = sparse_bytes / 1048576.;
+    figures["estimated_condensed_MB"]    = condensed_bytes / 1048576.;
+    figures["estimated_sparse_Gflop"]    = sparse_flops / 1e9;
+    figures["estimated_condensed_Gflop"] = condensed_flops / 1e9;
+    figures["available_MB"]              = available / 1048576.;
+    figures["process_virtual_MB"] =
+      read_field("/proc/self/status", "VmSize:", 1024.) / 1048576.;
+    figures["contact_unknowns"] = k;
+
+    SolverPath  path = requested;
+    std::string reason;
+    if (requested == SolverPath::automatic)
+      {
+        path   = condensed_flops <= sparse_flops ? SolverPath::condensed
+                                                 : SolverPath::sparse;
+        reason = "estimated " + gigaflops(condensed_flops) +
+                 " condensed (k = " + std::to_string(int(k)) +
+                 " contact unknowns, P = " + std::to_string(int(P)) +
+                 " rows) against " + gigaflops(sparse_flops) +
+                 " sparse (factorisations of " + gigaflops(fl) + ")";
+        if (path == SolverPath::condensed && !fits(condensed_bytes) &&
+            fits(sparse_bytes))
+          {
+            path = SolverPath::sparse;
+            reason += "; the condensed path's " + megabytes(condensed_bytes) +
+                      " exceed the " + megabytes(available) + " available";
+          }
+      }
+    else if (requested == SolverPath::condensed && !fits(condensed_bytes) &&
+             fits(sparse_bytes))
+      {
+        path   = SolverPath::sparse;
+        reason = "Contact/Solver = condensed needs about " +
+                 megabytes(condensed_bytes) + " but " + megabytes(available) +
+                 " are available (" + limit + ")";
+      }
+    else
+      reason = "as Contact/Solver says";
+    // Neither fits: name the smaller of the two needs.
+    if (!fits(condensed_bytes) && !fits(sparse_bytes))
+      path = condensed_bytes < sparse_bytes ? SolverPath::condensed
+                                            : SolverPath::sparse;
+    const double needed =
+      path == SolverPath::condensed ? condensed_bytes : sparse_bytes;
+    AssertThrow(fits(needed),
+                ExcMessage("out of memory: the contact solve (" +
+                           solver_path_name(path) + " path) needs about " +
+                           megabytes(needed) + " more, but " +
+                           megabytes(available) + " are available (" + limit +
+                           "); use fewer refinement cycles, a coarser mesh "
+                           "or a machine with more memory"));
+
+    if (path == SolverPath::condensed)
+      try
+        {
+          // The ordering and analysis made for the choice belong to this
+          // path's cost too (the sparse path reports them itself).
+          auto sparse_figures          = sparse->statistics();
+          figures["choice_ordering"]   = sparse_figures["ordering"];
+          figures["choice_analysis"]   = sparse_figures["analysis"];
+          const std::vector<int> order = sparse->ordering();
+          sparse.reset();
+          auto system = std::make_unique<CondensedContactSystem>(matrix,
+                                                                 base,
+                                                                 pairs,
+                                                                 order);
+          name        = "condensed";
+          log << "   solver: condensed (" << reason << ")" << std::endl;
+          return system;
+        }
+      catch (const ContactSystem::ExcNotPositiveDefinite &)
+        {
+          // A body held by fewer contact unknowns than its rigid motions
+          // (e.g. a single contact vertex) leaves C_ii singular; the sparse
+          // path constrains before factorising.
+          reason = "the interior of a body is not held without its contact "
+                   "rows, which the condensed path needs";
+          if (!fits(sparse_bytes))
+            AssertThrow(false,
+                        ExcMessage("out of memory: the contact solve (sparse "
+                                   "path) needs about " +
+                                   megabytes(sparse_bytes) + " more, but " +
+                                   megabytes(available) + " are available (" +
+                                   limit + ")"));
+          sparse = std::make_unique<SparseContactSystem>(matrix, base, pairs);
+        }
+    name = "sparse";
+    log << "   solver: sparse (" << reason << ")" << std::endl;
+    return sparse;
+  }
+} // namespace knee_contact
