@@ -10,7 +10,8 @@
 #include <new>
 #include <stdexcept>
 
-// knee_contact: unilateral contact between linear elastic bodies in 2D.
+// knee_contact: unilateral contact between linear elastic bodies in 2D, and
+// linear elasticity in 3D (the dimension comes from the mesh).
 // Usage: knee_contact [--dry-run] scene.prm | --help | --print-parameters
 int
 main(int argc, char **argv)
@@ -35,15 +36,19 @@ main(int argc, char **argv)
         }
       if (argc == 2 && std::strcmp(argv[1], "--print-parameters") == 0)
         {
+          // The 2D scene format; in 3D the vectors have a z component.
           ParameterHandler prm;
-          ContactProblem::declare_parameters(prm, ContactProblem::Counts());
+          ContactProblem<2>::declare_parameters(prm,
+                                                ContactProblem<2>::Counts());
           prm.print_parameters(std::cout, ParameterHandler::Text);
           return ExitCode::success;
         }
       if (argc == 3 && std::strcmp(argv[1], "--dry-run") == 0)
         {
-          ContactProblem problem(argv[2]);
-          problem.check_scene();
+          if (scene_dimension(argv[2]) == 3)
+            ContactProblem<3>(argv[2]).check_scene();
+          else
+            ContactProblem<2>(argv[2]).check_scene();
           return ExitCode::success;
         }
       if (argc != 2 || argv[1][0] == '-')
@@ -53,8 +58,9 @@ main(int argc, char **argv)
                     << std::endl;
           return ExitCode::input_error;
         }
-      ContactProblem problem(argv[1]);
-      return problem.run();
+      if (scene_dimension(argv[1]) == 3)
+        return ContactProblem<3>(argv[1]).run();
+      return ContactProblem<2>(argv[1]).run();
     }
   // A message built for the user (ExcMessage from AssertThrow, or a
   // runtime_error of the input checks) is bad input; out of memory is said

@@ -116,7 +116,7 @@ namespace
 int
 main()
 {
-  ContactProblem problem(SOURCE_DIR "/qp_scene.prm");
+  ContactProblem<2> problem(SOURCE_DIR "/qp_scene.prm");
   const int      status = problem.run();
 
   const DoFHandler<2> &dofs = problem.dof_handler_of();
@@ -194,12 +194,13 @@ main()
   double       row_error = pairs.size() == n_slave ? 0 : 1;
   double       gap_error = 0, length_error = 0;
   unsigned int matched = 0;
-  for (const auto &pair : pairs)
+  for (unsigned int p = 0; p < pairs.size(); ++p)
     for (unsigned int s = 0; s < n_slave; ++s)
-      if (pair.position.distance(positions[s]) < 1e-12)
+      if (pairs.points[p].position.distance(positions[s]) < 1e-12)
         {
           ++matched;
-          Vector<double> row(n);
+          const ContactRow &pair = pairs.rows[p];
+          Vector<double>    row(n);
           for (const auto &[dof, a] : pair.row)
             row(dof) += a;
           row -= rows[s];
@@ -233,7 +234,7 @@ main()
   // integrated here by Simpson's rule between all slave and master vertices
   // (the integrand is quadratic on each piece, so Simpson is exact): a
   // different rule and a global instead of a face-by-face formulation.
-  ContactProblem mortar(SOURCE_DIR "/qp_scene_mortar.prm");
+  ContactProblem<2> mortar(SOURCE_DIR "/qp_scene_mortar.prm");
   pass                             = pass && mortar.run() == 0;
   const DoFHandler<2> &mortar_dofs = mortar.dof_handler_of();
   const auto           mortar_dof  = [&](const Point<2> &c, const Point<2> &p) {
@@ -255,9 +256,11 @@ main()
     breaks.push_back(s * hs);
   std::sort(breaks.begin(), breaks.end());
   double mortar_error = mortar.pairs().size() == n_slave ? 0 : 1;
-  for (const auto &pair : mortar.pairs())
+  for (unsigned int p = 0; p < mortar.pairs().size(); ++p)
     {
-      const unsigned int  j = std::lround(pair.position[0] / hs);
+      const ContactRow   &pair = mortar.pairs().rows[p];
+      const unsigned int  j =
+        std::lround(mortar.pairs().points[p].position[0] / hs);
       Vector<double>      expected(mortar_dofs.n_dofs());
       double              W = 0;
       std::vector<double> M(n_master);

@@ -25,13 +25,13 @@ namespace
   check(const std::string &scene)
   {
     std::cout << "scene " << scene << std::endl;
-    ContactProblem problem(SOURCE_DIR "/" + scene);
+    ContactProblem<2> problem(SOURCE_DIR "/" + scene);
     const int      status = problem.run();
 
     const auto        &K     = problem.matrix();
     const auto        &f     = problem.rhs();
     const auto        &base  = problem.base_constraints();
-    const auto        &pairs = problem.pairs();
+    const auto        &pairs = problem.pairs().rows;
     const unsigned int n     = K.m();
 
     // x = C0 z + g0 over the dofs free of Gamma_u.

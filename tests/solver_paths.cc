@@ -38,7 +38,7 @@ namespace
   Run
   run(const std::string &scene, const ActiveSetSolver::LinearSolver solver)
   {
-    ContactProblem problem(SOURCE_DIR "/" + scene);
+    ContactProblem<2> problem(SOURCE_DIR "/" + scene);
     problem.contact_solver().set_linear_solver(solver);
     Run result;
     // The runs' own tables are not part of this test's output.

@@ -45,17 +45,6 @@ namespace knee_contact
 
 
 
-  double
-  ContactPair::jump(const Vector<double> &x) const
-  {
-    double value = 0;
-    for (const auto &[dof, coefficient] : row)
-      value += coefficient * x(dof);
-    return value;
-  }
-
-
-
   void
   ContactInterfaces::declare_parameters(ParameterHandler  &prm,
                                         const unsigned int n_interfaces)
@@ -161,8 +150,9 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  ContactInterfaces::check_mesh(const Triangulation<2>          &triangulation,
+  ContactInterfaces::check_mesh(const Triangulation<dim>        &triangulation,
                                 const std::vector<unsigned int> &body_ids) const
   {
     for (unsigned int i = 0; i < list.size(); ++i)
@@ -217,7 +207,7 @@ namespace knee_contact
     // Substitute the Gamma_u/Gamma_o lines into a row: x_i = sum_j c_ij x_j
     // + g_i for every constrained i, so the row acts on free dofs only.
     void
-    reduce_row(ContactPair &pair, const AffineConstraints<double> &constraints)
+    reduce_row(ContactRow &pair, const AffineConstraints<double> &constraints)
     {
       std::map<types::global_dof_index, double> reduced;
       double                                    rhs = pair.gap;
@@ -283,13 +273,13 @@ namespace knee_contact
 
 
 
-  std::vector<ContactPair>
+  ContactPairs<2>
   node_to_segment_rows(const ContactSides     &sides,
                        const ContactInterface &interface,
                        const unsigned int      interface_index,
                        const std::string      &where)
   {
-    std::vector<ContactPair> pairs;
+    ContactPairs<2> pairs;
     for (const auto &[vertex, slave] : sides.slaves)
       {
         const Tensor<1, 2> n   = slave.unit_normal();
@@ -343,14 +333,10 @@ namespace knee_contact
                                std::to_string(-best_s) +
                                " m; initial overlap is not supported"));
 
-        ContactPair pair;
-        pair.interface    = interface_index;
-        pair.position     = slave.position;
-        pair.normal       = n;
-        pair.gap          = best_s;
-        pair.master_point = slave.position + best_s * n;
-        pair.length       = slave.length;
-        pair.slave_dofs   = slave.dofs;
+        ContactRow pair;
+        pair.interface = interface_index;
+        pair.gap       = best_s;
+        pair.length    = slave.length;
         for (unsigned int d = 0; d < 2; ++d)
           pair.row.emplace_back(slave.dofs[d], n[d]);
         for (unsigned int v = 0; v < 2; ++v)
@@ -360,19 +346,20 @@ namespace knee_contact
               for (unsigned int d = 0; d < 2; ++d)
                 pair.row.emplace_back(best->dofs[v][d], -weight * n[d]);
           }
-        pairs.push_back(pair);
+        pairs.push_back(std::move(pair), {slave.position, n, slave.dofs});
       }
     return pairs;
   }
 
 
 
-  std::vector<ContactPair>
-  ContactInterfaces::make_pairs(
+  template <>
+  ContactPairs<2>
+  ContactInterfaces::make_pairs<2>(
     const DoFHandler<2>             &dof_handler,
     const AffineConstraints<double> &constraints) const
   {
-    std::vector<ContactPair>          pairs;
+    ContactPairs<2>                   pairs;
     std::set<types::global_dof_index> eliminated;
     for (unsigned int i = 0; i < list.size(); ++i)
       {
@@ -382,13 +369,15 @@ namespace knee_contact
                                   " ('" + interface.name + "'): ";
         AssertThrow(!sides.slaves.empty() && !sides.master_faces.empty(),
                     ExcMessage(where + "a side has no faces"));
-        std::vector<ContactPair> rows =
+        ContactPairs<2> rows =
           interface.pairing == Pairing::mortar
             ? mortar_rows(sides, interface, i, where)
             : node_to_segment_rows(sides, interface, i, where);
 
-        for (ContactPair &pair : rows)
+        for (unsigned int p = 0; p < rows.size(); ++p)
           {
+            ContactRow &pair = rows.rows[p];
+            const auto &slave_dofs = rows.points[p].slave_dofs;
             reduce_row(pair, constraints);
             // Eliminate the free slave component with the largest |n|,
             // else the largest free other component.
@@ -398,7 +387,7 @@ namespace knee_contact
                 for (const auto &[dof, a] : pair.reduced_row)
                   {
                     const bool on_slave =
-                      dof == pair.slave_dofs[0] || dof == pair.slave_dofs[1];
+                      dof == slave_dofs[0] || dof == slave_dofs[1];
                     if (on_slave == slave_side && !eliminated.count(dof) &&
                         std::abs(a) > largest + 1e-12)
                       {
@@ -411,9 +400,33 @@ namespace knee_contact
               }
             if (pair.eliminated != numbers::invalid_dof_index)
               eliminated.insert(pair.eliminated);
-            pairs.push_back(std::move(pair));
+            pairs.push_back(std::move(pair), rows.points[p]);
           }
       }
     return pairs;
   }
+
+
+
+  template <>
+  ContactPairs<3>
+  ContactInterfaces::make_pairs<3>(const DoFHandler<3> &,
+                                   const AffineConstraints<double> &) const
+  {
+    AssertThrow(list.empty(),
+                ExcMessage("Contact: the mesh is 3D and 3D contact is not "
+                           "implemented yet (3D elasticity is; set Number "
+                           "of interfaces = 0 and hold the bodies by "
+                           "boundary conditions)"));
+    return {};
+  }
+
+
+
+  template void
+  ContactInterfaces::check_mesh(const Triangulation<2> &,
+                                const std::vector<unsigned int> &) const;
+  template void
+  ContactInterfaces::check_mesh(const Triangulation<3> &,
+                                const std::vector<unsigned int> &) const;
 } // namespace knee_contact

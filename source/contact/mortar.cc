@@ -19,7 +19,7 @@
 // is lumped, see below). Each row is
 // divided by its weight W_j = sum_i D_ji = int psi_j, so that it reads like
 // a node-to-segment row (own normal displacement minus a weighted mean of
-// the master's) and the multiplier divided by ContactPair::length = W_j is
+// the master's) and the multiplier divided by ContactRow::length = W_j is
 // the coefficient of the pressure in the dual basis: a constant pressure p
 // gives exactly p at every vertex.
 
@@ -73,7 +73,7 @@ namespace knee_contact
 
 
 
-  std::vector<ContactPair>
+  ContactPairs<2>
   mortar_rows(const ContactSides     &sides,
               const ContactInterface &interface,
               const unsigned int      interface_index,
@@ -194,7 +194,7 @@ namespace knee_contact
           }
       }
 
-    std::vector<ContactPair> pairs;
+    ContactPairs<2> pairs;
     for (const auto &[key, row] : rows)
       {
         const ContactSides::SlaveVertex &vertex = sides.slaves.at(key);
@@ -206,14 +206,10 @@ namespace knee_contact
           continue;
         const Tensor<1, 2> n   = vertex.unit_normal();
         const double       gap = row.gap / weight;
-        ContactPair        pair;
-        pair.interface    = interface_index;
-        pair.position     = vertex.position;
-        pair.normal       = n;
-        pair.gap          = std::abs(gap) <= tol ? 0. : gap;
-        pair.master_point = vertex.position + pair.gap * n;
-        pair.length       = weight;
-        pair.slave_dofs   = vertex.dofs;
+        ContactRow         pair;
+        pair.interface = interface_index;
+        pair.gap       = std::abs(gap) <= tol ? 0. : gap;
+        pair.length    = weight;
         // D lumped onto the diagonal (D_jj = W_j, so the row's own
         // coefficient is n_j): where the master covers a slave face only in
         // part, int psi_j phi_i (i != j) is not zero, and keeping it would
@@ -228,7 +224,7 @@ namespace knee_contact
           if (M != 0)
             for (unsigned int d = 0; d < 2; ++d)
               pair.row.emplace_back(dofs[d], -M / weight * n[d]);
-        pairs.push_back(pair);
+        pairs.push_back(std::move(pair), {vertex.position, n, vertex.dofs});
       }
     return pairs;
   }

@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -63,14 +64,18 @@ namespace knee_contact
 
 
 
-    Point<2>
+    template <int dim>
+    Point<dim>
     to_point(const std::string &text, const std::string &parameter)
     {
       const auto xy = split(text, ',');
-      AssertThrow(xy.size() == 2,
-                  ExcMessage(parameter + ": '" + text +
-                             "' is not a point 'x, y'"));
-      return Point<2>(to_double(xy[0], parameter), to_double(xy[1], parameter));
+      AssertThrow(xy.size() == dim,
+                  ExcMessage(parameter + ": '" + text + "' is not a point " +
+                             (dim == 2 ? "'x, y'" : "'x, y, z'")));
+      Point<dim> p;
+      for (unsigned int d = 0; d < dim; ++d)
+        p[d] = to_double(xy[d], parameter);
+      return p;
     }
 
 
@@ -97,7 +102,8 @@ namespace knee_contact
 
 
 
-    std::unique_ptr<FunctionParser<2>>
+    template <int dim>
+    std::unique_ptr<FunctionParser<dim>>
     parse_expression(const std::string &expression,
                      const unsigned int n_components,
                      const std::string &parameter,
@@ -105,11 +111,20 @@ namespace knee_contact
                      const bool         load)
     {
       const auto parts = split(expression, ';');
+      // A vector of the other dimension is a scene written for a mesh of
+      // the other dimension: say which one this is.
+      const bool other_dimension =
+        n_components == dim && parts.size() == (dim == 2 ? 3u : 2u);
       AssertThrow(parts.size() == n_components,
                   ExcMessage("parameter '" + parameter + "': expected " +
                              std::to_string(n_components) +
                              " component(s) separated by ';', got '" +
-                             expression + "'"));
+                             expression + "'" +
+                             (!other_dimension ? ""
+                              : dim == 2 ? " (the mesh is 2D: give x and y "
+                                           "components)"
+                                         : " (the mesh is 3D: give x, y and "
+                                           "z components)")));
       std::map<std::string, double> constant_map = {{"pi", numbers::PI}};
       for (const auto &c : split(constants, ','))
         if (!c.empty())
@@ -126,21 +141,28 @@ namespace knee_contact
       // solutions; a fourth order formula with h = 1e-4 keeps their error
       // near 1e-13 for smooth fields.
       auto function =
-        std::make_unique<FunctionParser<2>>(n_components, 0., 1e-4);
-      function->set_formula(AutoDerivativeFunction<2>::FourthOrder);
+        std::make_unique<FunctionParser<dim>>(n_components, 0., 1e-4);
+      function->set_formula(AutoDerivativeFunction<dim>::FourthOrder);
       // deal.II prints muparser's complaint to std::cerr before it throws;
       // silence that, the message below says it in one line.
       std::ostringstream    muparser_output;
       std::streambuf *const cerr_buffer =
         std::cerr.rdbuf(muparser_output.rdbuf());
       Vector<double> values(n_components);
+      // A generic point: no coordinate 0 or 1, where singular expressions
+      // (1/x, log(y - 1)) would hide.
+      Point<dim> generic;
+      for (unsigned int d = 0; d < dim; ++d)
+        generic[d] = std::array<double, 3>{{0.123456789, 0.234567891,
+                                            0.345678912}}[d];
+      const std::string variables = dim == 2 ? "x,y" : "x,y,z";
       try
         {
-          function->initialize(load ? "x,y,t" : "x,y",
+          function->initialize(load ? variables + ",t" : variables,
                                parts,
                                constant_map,
                                load);
-          function->vector_value(Point<2>(0.123456789, 0.234567891), values);
+          function->vector_value(generic, values);
           std::cerr.rdbuf(cerr_buffer);
         }
       catch (const std::exception &exc)
@@ -163,8 +185,11 @@ namespace knee_contact
       for (unsigned int c = 0; c < n_components; ++c)
         AssertThrow(std::isfinite(values(c)),
                     ExcMessage("parameter '" + parameter + "': '" + expression +
-                               "' is not finite (inf or nan) at (x, y) = "
-                               "(0.123456789, 0.234567891)"));
+                               "' is not finite (inf or nan) at " +
+                               (dim == 2 ? "(x, y) = (0.123456789, "
+                                           "0.234567891)"
+                                         : "(x, y, z) = (0.123456789, "
+                                           "0.234567891, 0.345678912)")));
       return function;
     }
 
@@ -174,7 +199,7 @@ namespace knee_contact
     evaluate_constant(const std::string &expression,
                       const std::string &parameter)
     {
-      const auto   function = parse_expression(expression, 1, parameter);
+      const auto   function = parse_expression<2>(expression, 1, parameter);
       const double value    = function->value(Point<2>());
       AssertThrow(std::isfinite(value),
                   ExcMessage("parameter '" + parameter + "': '" + expression +
@@ -274,5 +299,22 @@ namespace knee_contact
                                  "' is not valid UTF-8 text"));
         }
     }
+
+    template Point<2>
+    to_point<2>(const std::string &, const std::string &);
+    template Point<3>
+    to_point<3>(const std::string &, const std::string &);
+    template std::unique_ptr<FunctionParser<2>>
+    parse_expression<2>(const std::string &,
+                        const unsigned int,
+                        const std::string &,
+                        const std::string &,
+                        const bool);
+    template std::unique_ptr<FunctionParser<3>>
+    parse_expression<3>(const std::string &,
+                        const unsigned int,
+                        const std::string &,
+                        const std::string &,
+                        const bool);
   } // namespace input
 } // namespace knee_contact

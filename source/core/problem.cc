@@ -66,8 +66,9 @@ namespace knee_contact
 
 
 
-  ContactProblem::Counts
-  ContactProblem::read_counts(const std::string &scene_file)
+  template <int dim>
+  typename ContactProblem<dim>::Counts
+  ContactProblem<dim>::read_counts(const std::string &scene_file)
   {
     ParameterHandler prm;
     declare_parameters(prm, Counts{0, 0, 0});
@@ -87,24 +88,26 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  ContactProblem::declare_parameters(ParameterHandler &prm,
+  ContactProblem<dim>::declare_parameters(ParameterHandler &prm,
                                      const Counts     &counts)
   {
-    MeshInput::declare_parameters(prm);
-    Materials::declare_parameters(prm, counts.n_materials);
-    BoundaryConditions::declare_parameters(prm, counts.n_conditions);
+    MeshInput<dim>::declare_parameters(prm);
+    Materials<dim>::declare_parameters(prm, counts.n_materials);
+    BoundaryConditions<dim>::declare_parameters(prm, counts.n_conditions);
     ContactInterfaces::declare_parameters(prm, counts.n_interfaces);
     ActiveSetSolver::declare_parameters(prm);
     LoadCases::declare_parameters(prm);
-    OutputWriter::declare_parameters(prm);
-    Verification::declare_parameters(prm);
+    OutputWriter<dim>::declare_parameters(prm);
+    Verification<dim>::declare_parameters(prm);
     Refinement::declare_parameters(prm);
   }
 
 
 
-  ContactProblem::ContactProblem(const std::string &scene_file)
+  template <int dim>
+  ContactProblem<dim>::ContactProblem(const std::string &scene_file)
     : scene_file(scene_file)
   {
     const Counts       counts = read_counts(scene_file);
@@ -136,12 +139,18 @@ namespace knee_contact
     refinement.parse_parameters(prm);
     mesh_input.adaptive = refinement.strategy != Refinement::Strategy::global;
     scene_checks::check_roles(boundary_conditions, contact_interfaces);
+    AssertThrow(dim == 2 || contact_interfaces.interfaces().empty(),
+                ExcMessage("Contact/Number of interfaces: the mesh is 3D and "
+                           "3D contact is not implemented yet (3D elasticity "
+                           "is); set it to 0 and hold every body by boundary "
+                           "conditions"));
   }
 
 
 
+  template <int dim>
   std::ostream &
-  ContactProblem::log() const
+  ContactProblem<dim>::log() const
   {
     if (output_writer.test_mode())
       {
@@ -153,11 +162,13 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  ContactProblem::make_mesh()
+  ContactProblem<dim>::make_mesh(const unsigned int level)
   {
-    mesh_input.create(triangulation);
-    fe = elements::displacement_element<2>(elements::cell_kind(triangulation));
+    mesh_input.create(triangulation, level);
+    fe =
+      elements::displacement_element<dim>(elements::cell_kind(triangulation));
     materials.check_mesh(triangulation);
     boundary_conditions.check_mesh(triangulation);
     body_of_cell = compute_body_ids(triangulation, n_bodies);
@@ -167,10 +178,11 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  ContactProblem::check_scene()
+  ContactProblem<dim>::check_scene()
   {
-    make_mesh();
+    make_mesh(0);
     std::cout << scene_file << ": " << triangulation.n_active_cells()
               << " cells, " << n_bodies << " bodies, "
               << contact_interfaces.interfaces().size()
@@ -179,8 +191,9 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  ContactProblem::setup_system()
+  ContactProblem<dim>::setup_system()
   {
     dof_handler.reinit(triangulation);
     dof_handler.distribute_dofs(*fe);
@@ -198,19 +211,22 @@ namespace knee_contact
     boundary_conditions.make_constraints(dof_handler, constraints);
     contact_pairs = contact_interfaces.make_pairs(dof_handler, constraints);
 
-    ActiveSetSolver::make_sparsity_pattern(dof_handler,
+    DynamicSparsityPattern mesh_pattern(dof_handler.n_dofs());
+    DoFTools::make_sparsity_pattern(dof_handler, mesh_pattern);
+    ActiveSetSolver::make_sparsity_pattern(mesh_pattern,
                                            constraints,
-                                           contact_pairs,
+                                           contact_pairs.rows,
                                            sparsity_pattern);
     system_matrix.reinit(sparsity_pattern);
   }
 
 
 
+  template <int dim>
   std::vector<CycleRecord>
-  ContactProblem::run_cycles(const Refinement::Strategy strategy,
+  ContactProblem<dim>::run_cycles(const Refinement::Strategy strategy,
                              TimerOutput               &timer,
-                             Results                   &results)
+                             Results<dim>              &results)
   {
     std::vector<CycleRecord> records;
     const unsigned int       n_cycles = strategy == Refinement::Strategy::global
@@ -232,7 +248,10 @@ namespace knee_contact
 
         timed("mesh", [&]() {
           if (cycle == 0)
-            make_mesh();
+            make_mesh(0);
+          else if (strategy == Refinement::Strategy::global &&
+                   mesh_input.remeshes(triangulation))
+            make_mesh(cycle);
           else
             {
               refinement.refine(strategy,
@@ -256,7 +275,7 @@ namespace knee_contact
                   << " bodies, " << contact_pairs.size() << " contact pairs"
                   << std::endl;
         timed("assembly", [&]() {
-          ElasticityAssembler assembler(materials, boundary_conditions);
+          ElasticityAssembler<dim> assembler(materials, boundary_conditions);
           assembler.assemble(dof_handler, system_matrix, system_rhs);
         });
         timed("solve", [&]() {
@@ -268,7 +287,8 @@ namespace knee_contact
               guess.assign(contact_pairs.size(), false);
               for (unsigned int p = 0; p < contact_pairs.size(); ++p)
                 for (const auto &[position, length] : previous_contact)
-                  if (contact_pairs[p].position.distance(position) <= length)
+                  if (contact_pairs.points[p].position.distance(position) <=
+                      length)
                     guess[p] = true;
             }
           solve_contact(guess, true);
@@ -282,8 +302,9 @@ namespace knee_contact
         previous_contact.clear();
         for (unsigned int p = 0; p < contact_pairs.size(); ++p)
           if (contact_solution.active[p])
-            previous_contact.emplace_back(contact_pairs[p].position,
-                                          contact_pairs[p].length);
+            previous_contact.emplace_back(
+              contact_pairs.points[p].position,
+              std::pow(contact_pairs.rows[p].length, 1. / (dim - 1)));
         record.n_cells        = triangulation.n_active_cells();
         record.n_dofs         = dof_handler.n_dofs();
         record.n_pairs        = contact_pairs.size();
@@ -312,11 +333,12 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  ContactProblem::solve_contact(const std::vector<bool> &guess,
+  ContactProblem<dim>::solve_contact(const std::vector<bool> &guess,
                                 const bool               new_matrix)
   {
-    const RigidModes rigid_modes(dof_handler, body_of_cell, body_names);
+    const RigidModes<dim> rigid_modes(dof_handler, body_of_cell, body_names);
     std::ostream    &loop_log = contact_pairs.empty() ? quiet : std::cout;
     try
       {
@@ -329,7 +351,7 @@ namespace knee_contact
               make_contact_system(active_set_solver.linear_solver(),
                                   system_matrix,
                                   constraints,
-                                  contact_pairs,
+                                  contact_pairs.rows,
                                   !guess.empty(),
                                   output_writer.test_mode() ? quiet : loop_log,
                                   solver_name,
@@ -339,7 +361,7 @@ namespace knee_contact
         contact_solution = active_set_solver.solve(*contact_system,
                                                    system_rhs.linfty_norm(),
                                                    constraints,
-                                                   contact_pairs,
+                                                   contact_pairs.rows,
                                                    rigid_modes,
                                                    guess,
                                                    loop_log);
@@ -354,7 +376,7 @@ namespace knee_contact
               reference_solve(system_matrix,
                               system_rhs,
                               constraints,
-                              contact_pairs,
+                              contact_pairs.rows,
                               contact_solution.active,
                               x);
             x -= displacement;
@@ -397,8 +419,9 @@ namespace knee_contact
 
 
 
-  Results
-  ContactProblem::current_results() const
+  template <int dim>
+  Results<dim>
+  ContactProblem<dim>::current_results() const
   {
     return compute_results(dof_handler,
                            body_of_cell,
@@ -414,8 +437,9 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  ContactProblem::set_load_parameter(const double t)
+  ContactProblem<dim>::set_load_parameter(const double t)
   {
     materials.set_load_parameter(t);
     boundary_conditions.set_load_parameter(t);
@@ -424,9 +448,10 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  ContactProblem::write_result_set(
-    const Results                               &results,
+  ContactProblem<dim>::write_result_set(
+    const Results<dim>                          &results,
     const std::vector<std::vector<CycleRecord>> &sequences,
     TimerOutput                                 &timer)
   {
@@ -502,7 +527,9 @@ namespace knee_contact
     {
       TimerOutput::Scope scope(timer, "pictures");
       std::string        message;
-      if (!output_writer.run_script("plot_results.py", message) ||
+      if (!output_writer.run_script(dim == 2 ? "plot_results.py"
+                                             : "plot_results_3d.py",
+                                    message) ||
           (sequences.size() > 1 &&
            !output_writer.run_script("plot_study.py", message)))
         output_writer.warn("no pictures: " + message);
@@ -517,18 +544,19 @@ namespace knee_contact
 
 
 
+  template <int dim>
   unsigned int
-  ContactProblem::run_load_cases(
-    const Results                               &first_results,
+  ContactProblem<dim>::run_load_cases(
+    const Results<dim>                          &first_results,
     const std::vector<std::vector<CycleRecord>> &sequences,
     TimerOutput                                 &timer)
   {
-    const std::vector<double>     &t = load_cases.values();
-    std::vector<LoadCases::Record> records;
+    const std::vector<double>          &t = load_cases.values();
+    std::vector<LoadCases::Record<dim>> records;
     const auto                     record = [&](const double   t_case,
                             const double   solve_time,
-                            const Results &results) {
-      LoadCases::Record r;
+                            const Results<dim> &results) {
+      LoadCases::Record<dim> r;
       r.t            = t_case;
       r.n_iterations = contact_solution.n_iterations;
       r.converged    = contact_solution.converged;
@@ -536,7 +564,8 @@ namespace knee_contact
       r.results      = results;
       // The table needs the figures, not the per-cell and per-pair fields
       // (tens of MB per case on a fine mesh).
-      std::vector<std::array<double, 4>>().swap(r.results.vertex_stress_yy);
+      decltype(r.results.vertex_stress_yy)().swap(r.results.vertex_stress_yy);
+      decltype(r.results.vertex_von_mises)().swap(r.results.vertex_von_mises);
       std::vector<double>().swap(r.results.pressure);
       records.push_back(std::move(r));
     };
@@ -555,7 +584,7 @@ namespace knee_contact
         Timer clock;
         {
           TimerOutput::Scope scope(timer, "load cases: assembly");
-          ElasticityAssembler(materials, boundary_conditions)
+          ElasticityAssembler<dim>(materials, boundary_conditions)
             .assemble_rhs(dof_handler, system_rhs);
         }
         {
@@ -565,7 +594,7 @@ namespace knee_contact
           solve_contact(contact_solution.active, false);
         }
         const double solve_time = clock.wall_time();
-        Results      results;
+        Results<dim> results;
         {
           TimerOutput::Scope scope(timer, "postprocess");
           results = current_results();
@@ -613,8 +642,9 @@ namespace knee_contact
 
 
 
+  template <int dim>
   int
-  ContactProblem::run()
+  ContactProblem<dim>::run()
   {
     TimerOutput timer(log(), TimerOutput::never, TimerOutput::wall_times);
     output_writer.prepare();
@@ -627,12 +657,15 @@ namespace knee_contact
       strategies = {Refinement::Strategy::global,
                     Refinement::Strategy::adaptive};
     std::vector<std::vector<CycleRecord>> sequences;
-    Results                               results;
+    Results<dim>                          results;
     for (const auto strategy : strategies)
       sequences.push_back(run_cycles(strategy, timer, results));
     for (const auto &records : sequences)
       if (records.size() > 1)
-        print_convergence_table(records, !output_writer.test_mode(), std::cout);
+        print_convergence_table(records,
+                                dim,
+                                !output_writer.test_mode(),
+                                std::cout);
 
     print_results(results);
 
@@ -693,16 +726,28 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  ContactProblem::print_results(const Results &results) const
+  ContactProblem<dim>::print_results(const Results<dim> &results) const
   {
     std::ostream &out = std::cout;
+    // Per unit thickness in 2D.
+    const std::string force_unit  = dim == 2 ? "[N/m]" : "[N]  ";
+    const std::string energy_unit = dim == 2 ? "[J/m]" : "[J]  ";
+    const auto        list = [](const auto &v, const auto &shown) {
+      std::ostringstream text;
+      text << std::scientific << std::setprecision(6);
+      for (unsigned int d = 0; d < dim; ++d)
+        text << (d == 0 ? "(" : ", ") << shown(v[d]);
+      return text.str() + ")";
+    };
     out << std::scientific << std::setprecision(6);
     out << "results:\n"
         << "  dofs " << results.n_dofs << ", cells " << results.n_cells
         << ", bodies " << results.n_bodies << "\n"
-        << "  applied load [N/m]           (" << results.applied_load[0] << ", "
-        << results.applied_load[1] << ")\n";
+        << "  applied load " << force_unit << "           "
+        << list(results.applied_load, [](const double f) { return f; })
+        << "\n";
     // A reaction component that is zero by physics comes out as round-off
     // of the force scale (1e-8 N/m beside 1e6 N/m); printed as it is, it
     // would make every comparison of this table with an earlier run fail on
@@ -724,11 +769,11 @@ namespace knee_contact
       return std::abs(s) <= 1e-12 * E ? 0. : s;
     };
     for (const auto &[id, reaction] : results.reactions)
-      out << "  reaction at boundary id " << std::setw(3) << id << " [N/m] ("
-          << shown(reaction[0]) << ", " << shown(reaction[1]) << ")\n";
+      out << "  reaction at boundary id " << std::setw(3) << id << " "
+          << force_unit << " " << list(reaction, shown) << "\n";
     out << "  equilibrium residual         " << std::setprecision(2)
         << results.equilibrium_residual << std::setprecision(6) << "\n"
-        << "  energy a(u,u) [J/m]          "
+        << "  energy a(u,u) " << energy_unit << "          "
         << (std::abs(results.energy) <= energy_noise ? 0. : results.energy)
         << "\n"
         << "  max |u| [m]                  " << results.max_displacement
@@ -738,6 +783,11 @@ namespace knee_contact
           << materials[id].name << std::right << " ["
           << shown_stress(range.first) << ", " << shown_stress(range.second)
           << "]\n";
+    if (dim == 3)
+      for (const auto &[id, value] : results.von_mises_max)
+        out << "  max von Mises [Pa] in " << std::left << std::setw(14)
+            << materials[id].name << std::right << " " << shown_stress(value)
+            << "\n";
     for (const auto &i : results.interfaces)
       out << "  contact '" << i.name << "': " << i.n_active << " of "
           << i.n_pairs << " pairs active, force [N/m] " << i.force
@@ -750,9 +800,26 @@ namespace knee_contact
     if (output_writer.test_mode())
       for (unsigned int p = 0; p < contact_pairs.size(); ++p)
         if (contact_solution.active[p])
-          out << "  pair at (" << contact_pairs[p].position[0] << ", "
-              << contact_pairs[p].position[1] << ") pressure [Pa] "
-              << results.pressure[p] << "\n";
+          out << "  pair at "
+              << list(contact_pairs.points[p].position,
+                      [](const double x) { return x; })
+              << " pressure [Pa] " << results.pressure[p] << "\n";
     out << std::defaultfloat << std::flush;
   }
+
+
+
+  unsigned int
+  scene_dimension(const std::string &scene_file)
+  {
+    ParameterHandler prm;
+    MeshInput<2>::declare_parameters(prm);
+    parse_scene(prm, scene_file, true);
+    return scene_dimension(prm, scene_file);
+  }
+
+
+
+  template class ContactProblem<2>;
+  template class ContactProblem<3>;
 } // namespace knee_contact

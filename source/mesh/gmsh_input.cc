@@ -52,8 +52,20 @@ namespace knee_contact
         [[noreturn]] void
         fail(const std::string &what) const
         {
+          fail_at(line_number, what);
+        }
+
+        [[noreturn]] void
+        fail_at(const unsigned long line, const std::string &what) const
+        {
           throw std::runtime_error("Mesh/File: '" + file + "' line " +
-                                   std::to_string(line_number) + ": " + what);
+                                   std::to_string(line) + ": " + what);
+        }
+
+        unsigned long
+        line() const
+        {
+          return line_number;
         }
 
         // The next line, split at white space; false at the end.
@@ -171,32 +183,70 @@ namespace knee_contact
 
 
 
-      // Nodes of the element types deal.II reads in 2D (linear ones).
-      unsigned int
-      n_nodes(const long long type, const MshReader &reader)
+      // Nodes and dimension of the element types deal.II reads (linear
+      // ones; wedges and pyramids have no element here).
+      std::pair<unsigned int, unsigned int>
+      nodes_and_dimension(const long long type, const MshReader &reader)
       {
         switch (type)
           {
             case 15:
-              return 1;
+              return {1, 0};
             case 1:
-              return 2;
+              return {2, 1};
             case 2:
-              return 3;
+              return {3, 2};
             case 3:
-              return 4;
+              return {4, 2};
+            case 4:
+              return {4, 3};
+            case 5:
+              return {8, 3};
+            case 6:
+            case 7:
+              reader.fail(std::string(type == 6 ? "wedges (prisms)"
+                                                : "pyramids") +
+                          " (element type " + std::to_string(type) +
+                          ") are not supported; mesh the volumes with "
+                          "tetrahedra (4) or hexahedra (5) only");
             default:
               reader.fail("element type " + std::to_string(type) +
                           " is not supported (points 15, lines 1, triangles "
-                          "2, quadrilaterals 3; linear elements only)");
+                          "2, quadrilaterals 3, tetrahedra 4, hexahedra 5; "
+                          "linear elements only)");
           }
       }
 
+      // The cells' dimension (the highest element dimension); refuses
+      // tetrahedra beside hexahedra, which no conforming mesh joins without
+      // pyramids.
+      struct CellKinds
+      {
+        unsigned int dimension = 0;
+        bool         tetrahedra = false, hexahedra = false;
+
+        void
+        add(const long long type, const MshReader &reader)
+        {
+          dimension = std::max(dimension, nodes_and_dimension(type, reader).second);
+          (type == 4 ? tetrahedra : hexahedra) |= type == 4 || type == 5;
+          if (tetrahedra && hexahedra)
+            reader.fail("the mesh has tetrahedra and hexahedra; a 3D mesh "
+                        "must have cells of one kind");
+        }
+      };
 
 
-      void
+
+      unsigned int
       check_msh2(MshReader &reader)
       {
+        CellKinds                     kinds;
+        // A face without a physical group is a cell without a material id
+        // if the mesh is 2D, a boundary without an id if it is 3D: known
+        // only at the end, so the first one is remembered.
+        std::string                   untagged_face;
+        unsigned long                 untagged_line = 0;
         std::unordered_set<long long> nodes;
         bool                          have_nodes = false, have_elements = false;
         std::vector<std::string>      t;
@@ -229,8 +279,10 @@ namespace knee_contact
                 for (unsigned long long i = 0; i < n; ++i)
                   {
                     t = reader.expect(4, 64, "an element");
-                    const unsigned int n_v =
-                      n_nodes(reader.tag(t[1], "element type"), reader);
+                    const long long type = reader.tag(t[1], "element type");
+                    const auto [n_v, element_dim] =
+                      nodes_and_dimension(type, reader);
+                    kinds.add(type, reader);
                     const long long n_tags = reader.tag(t[2], "tag count");
                     if (n_tags < 0 ||
                         t.size() != 3 + static_cast<std::size_t>(n_tags) + n_v)
@@ -242,10 +294,16 @@ namespace knee_contact
                     for (std::size_t k = 3; k < first_node; ++k)
                       if (reader.tag(t[k], "element tag") < 0)
                         reader.fail("element " + t[0] + " has a negative tag");
-                    if ((n_v == 3 || n_v == 4) && (n_tags == 0 || t[3] == "0"))
+                    const bool untagged = n_tags == 0 || t[3] == "0";
+                    if (element_dim == 3 && untagged)
                       reader.fail("cell " + t[0] +
                                   " has no physical group, so no material id "
-                                  "(give every surface a Physical Surface)");
+                                  "(give every volume a Physical Volume)");
+                    if (element_dim == 2 && untagged && untagged_face.empty())
+                      {
+                        untagged_face = t[0];
+                        untagged_line = reader.line();
+                      }
                     reader.check_element_nodes(nodes, t, first_node);
                   }
                 reader.end_of("Elements");
@@ -256,16 +314,26 @@ namespace knee_contact
           }
         if (!have_nodes || !have_elements)
           reader.fail("no $Nodes or no $Elements section (truncated?)");
+        if (kinds.dimension == 2 && !untagged_face.empty())
+          reader.fail_at(untagged_line,
+                         "cell " + untagged_face +
+                           " has no physical group, so no material id "
+                           "(give every surface a Physical Surface)");
+        return kinds.dimension;
       }
 
 
 
-      void
+      unsigned int
       check_msh4(MshReader &reader)
       {
+        CellKinds                     kinds;
         std::unordered_set<long long> nodes;
+        // Entities of the cells' dimension (surfaces in 2D, volumes in 3D:
+        // a mesh with volume entities is 3D) without a physical group.
         std::unordered_set<long long> unnamed_surfaces;
         unsigned int                  n_named_surfaces = 0;
+        unsigned int                  cell_dim         = 2;
         bool have_entities = false, have_nodes = false, have_elements = false;
         std::vector<std::string> t;
         while (reader.next(t))
@@ -275,6 +343,8 @@ namespace knee_contact
             if (t[0] == "$Entities")
               {
                 t = reader.expect(4, 4, "'numPoints numCurves ...'");
+                if (reader.count(t[3], "entity count") > 0)
+                  cell_dim = 3;
                 for (unsigned int dim = 0; dim < 4; ++dim)
                   {
                     const auto n = reader.count(t[dim], "entity count");
@@ -291,10 +361,10 @@ namespace knee_contact
                         if (e.size() < p + 1 + n_phys + (dim == 0 ? 0 : 1))
                           reader.fail("entity " + e[0] +
                                       " has fewer fields than its counts say");
-                        if (dim == 2 && n_phys == 0)
+                        if (dim == cell_dim && n_phys == 0)
                           unnamed_surfaces.insert(
                             reader.tag(e[0], "entity tag"));
-                        if (dim == 2 && n_phys > 0)
+                        if (dim == cell_dim && n_phys > 0)
                           ++n_named_surfaces;
                       }
                   }
@@ -303,12 +373,13 @@ namespace knee_contact
                 // are any: the cells of other surfaces would vanish.
                 if (n_named_surfaces > 0 && !unnamed_surfaces.empty())
                   reader.fail(
-                    "surface " +
+                    std::string(cell_dim == 2 ? "surface " : "volume ") +
                     std::to_string(*std::min_element(unnamed_surfaces.begin(),
                                                      unnamed_surfaces.end())) +
                     " has no physical group, so its cells would be "
-                    "dropped (give every surface a Physical "
-                    "Surface)");
+                    "dropped (give every " +
+                    (cell_dim == 2 ? "surface a Physical Surface)"
+                                   : "volume a Physical Volume)"));
                 have_entities = true;
               }
             else if (t[0] == "$Nodes")
@@ -351,16 +422,21 @@ namespace knee_contact
                 for (unsigned long long b = 0; b < n_blocks; ++b)
                   {
                     t = reader.expect(4, 4, "an element block header");
+                    const long long type = reader.tag(t[2], "element type");
                     const unsigned int n_v =
-                      n_nodes(reader.tag(t[2], "element type"), reader);
+                      nodes_and_dimension(type, reader).first;
+                    kinds.add(type, reader);
                     const auto n =
                       reader.count(t[3], "element count of a block");
-                    if (t[0] == "2" &&
+                    if (t[0] == std::to_string(cell_dim) &&
                         unnamed_surfaces.count(reader.tag(t[1], "entity tag")))
-                      reader.fail("surface " + t[1] +
-                                  " has no physical group, so its cells have "
-                                  "no material id (give every surface a "
-                                  "Physical Surface)");
+                      reader.fail(
+                        std::string(cell_dim == 2 ? "surface " : "volume ") +
+                        t[1] +
+                        " has no physical group, so its cells have "
+                        "no material id (give every " +
+                        (cell_dim == 2 ? "surface a Physical Surface)"
+                                       : "volume a Physical Volume)"));
                     for (unsigned long long i = 0; i < n; ++i)
                       {
                         t = reader.expect(1 + n_v,
@@ -378,6 +454,7 @@ namespace knee_contact
         if (!have_entities || !have_nodes || !have_elements)
           reader.fail("no $Entities, $Nodes or $Elements section "
                       "(truncated?)");
+        return kinds.dimension;
       }
     } // namespace
 
@@ -531,11 +608,12 @@ namespace knee_contact
          const double                    time_limit)
     {
       check_geo(geo);
-      // Format 4.1: its $Entities section lists every surface, so a surface
-      // without a physical group (whose cells GridIn would drop silently)
-      // can be found by check_msh.
+      // Format 4.1: its $Entities section lists every surface and volume, so
+      // one without a physical group (whose cells GridIn would drop
+      // silently) can be found by check_msh. -3 meshes the volumes of a 3D
+      // geometry and is -2 for a 2D one.
       std::vector<std::string> command = {
-        "gmsh", "-2", "-format", "msh41", "-v", "2", "-nopopup"};
+        "gmsh", "-3", "-format", "msh41", "-v", "2", "-nopopup"};
       command.insert(command.end(), extra.begin(), extra.end());
       command.insert(command.end(), {"-o", msh, geo});
       const std::string log =
@@ -551,7 +629,7 @@ namespace knee_contact
 
 
 
-    void
+    unsigned int
     check_msh(const std::string &file)
     {
       MshReader                reader(file);
@@ -564,13 +642,15 @@ namespace knee_contact
                     "(Mesh.Binary = 0)");
       const std::string version = t[0];
       reader.end_of("MeshFormat");
-      if (version == "2.2" || version == "2")
-        check_msh2(reader);
-      else if (version == "4.1")
-        check_msh4(reader);
-      else
+      if (version != "2.2" && version != "2" && version != "4.1")
         reader.fail("format version " + version +
                     " is not supported (2.2 or 4.1)");
+      const unsigned int dim =
+        version == "4.1" ? check_msh4(reader) : check_msh2(reader);
+      if (dim < 2)
+        reader.fail("the mesh has no cells (no triangles, quadrilaterals, "
+                    "tetrahedra or hexahedra)");
+      return dim;
     }
   } // namespace gmsh_input
 } // namespace knee_contact

@@ -193,7 +193,7 @@ namespace knee_contact
        * (0 1 3 2 round a quadrilateral).
        */
       void
-      add_cell(Description              &mesh,
+      add_cell(Description<2>              &mesh,
                std::vector<unsigned int> vertices,
                const types::material_id  material_id)
       {
@@ -206,7 +206,7 @@ namespace knee_contact
       }
 
       void
-      add_boundary_line(Description             &mesh,
+      add_boundary_line(Description<2>             &mesh,
                         const unsigned int       a,
                         const unsigned int       b,
                         const types::boundary_id boundary_id)
@@ -220,7 +220,7 @@ namespace knee_contact
 
 
 
-    Description
+    Description<2>
     read_abaqus(const std::string                         &file,
                 const std::map<std::string, unsigned int> &element_sets,
                 const std::map<std::string, unsigned int> &boundary_sets)
@@ -486,7 +486,7 @@ namespace knee_contact
                                   : "name its set in the scene") +
                                ")"));
 
-      Description                       mesh;
+      Description<2>                       mesh;
       std::map<long long, unsigned int> vertex_of_node;
       for (const auto &[id, p] : nodes)
         {
@@ -601,7 +601,7 @@ namespace knee_contact
 
 
 
-    Description
+    Description<2>
     read_ucd(const std::string &file)
     {
       Lines       lines(file);
@@ -638,7 +638,7 @@ namespace knee_contact
       const std::size_t n_nodes = count(header[0], "node count"),
                         n_cells = count(header[1], "cell count");
 
-      Description                       mesh;
+      Description<2>                       mesh;
       std::map<long long, unsigned int> vertex_of_node;
       for (std::size_t i = 0; i < n_nodes; ++i)
         {
@@ -1004,7 +1004,7 @@ namespace knee_contact
 
 
 
-    Description
+    Description<2>
     read_vtu(const std::string &file)
     {
       const std::uintmax_t size = std::filesystem::file_size(file);
@@ -1119,7 +1119,7 @@ namespace knee_contact
         array("Cells", "connectivity", std::size_t(n_connected), true);
       const auto ids = array("CellData", "MaterialID", n_cells, false);
 
-      Description mesh;
+      Description<2> mesh;
       for (std::size_t i = 0; i < n_points; ++i)
         {
           for (unsigned int d = 0; d < 3; ++d)
@@ -1324,7 +1324,7 @@ namespace knee_contact
 
     void
     split_into_quadrilaterals(
-      Description                                  &mesh,
+      Description<2>                                  &mesh,
       const std::map<types::boundary_id, Point<2>> &circles)
     {
       // Each edge gets one midpoint, shared by the cells beside it, so the

@@ -1,6 +1,7 @@
 #include <knee_contact/mesh/scene_checks.h>
 
 #include <deal.II/base/bounding_box.h>
+#include <deal.II/base/qprojector.h>
 #include <deal.II/base/quadrature_lib.h>
 
 #include <deal.II/lac/vector.h>
@@ -22,11 +23,15 @@ namespace knee_contact
   {
     namespace
     {
+      template <int dim>
       std::string
-      at(const Point<2> &p)
+      at(const Point<dim> &p)
       {
         std::ostringstream out;
-        out << std::setprecision(6) << "(" << p[0] << ", " << p[1] << ")";
+        out << std::setprecision(6);
+        for (unsigned int d = 0; d < dim; ++d)
+          out << (d == 0 ? "(" : ", ") << p[d];
+        out << ")";
         return out.str();
       }
 
@@ -49,9 +54,10 @@ namespace knee_contact
 
 
 
+    template <int dim>
     void
-    check_roles(const BoundaryConditions &conditions,
-                const ContactInterfaces  &interfaces)
+    check_roles(const BoundaryConditions<dim> &conditions,
+                const ContactInterfaces       &interfaces)
     {
       for (const auto &interface : interfaces.interfaces())
         for (const auto id : {interface.slave_id, interface.master_id})
@@ -67,39 +73,40 @@ namespace knee_contact
 
 
 
+    template <int dim>
     void
-    check_finite_data(const Triangulation<2>   &triangulation,
-                      const Materials          &materials,
-                      const BoundaryConditions &conditions)
+    check_finite_data(const Triangulation<dim>      &triangulation,
+                      const Materials<dim>          &materials,
+                      const BoundaryConditions<dim> &conditions)
     {
-      const QGauss<1> face_points(2);
-      Vector<double>  values(2);
-      const auto      check = [&](const Function<2> &function,
-                             const Point<2>    &p,
-                             const std::string &parameter,
-                             const std::string &where) {
+      Vector<double> values(dim);
+      const auto     check = [&](const Function<dim> &function,
+                             const Point<dim>    &p,
+                             const std::string   &parameter,
+                             const std::string   &where) {
         function.vector_value(p, values);
         for (unsigned int c = 0; c < function.n_components; ++c)
           AssertThrow(std::isfinite(values(c)),
-                      ExcMessage(parameter +
-                                 ": not finite (inf or nan) at (x, y) = " +
+                      ExcMessage(parameter + ": not finite (inf or nan) at " +
+                                 (dim == 2 ? "(x, y) = " : "(x, y, z) = ") +
                                  at(p) + where));
       };
       for (const auto &cell : triangulation.active_cell_iterators())
         {
-          const Material   &material = materials[cell->material_id()];
+          const Material<dim> &material = materials[cell->material_id()];
           const auto       &force    = *material.body_force;
           const std::string parameter =
             "Materials (material '" + material.name + "')/Body force";
           for (const auto v : cell->vertex_indices())
             check(force, cell->vertex(v), parameter, "");
           // The Gauss points, mapped as the assembly maps them.
-          const auto &mapping =
-            cell->reference_cell().get_default_linear_mapping<2, 2>();
+          const ReferenceCell kind = cell->reference_cell();
+          const auto         &mapping =
+            kind.template get_default_linear_mapping<dim, dim>();
           // (The rule is kept in a named variable: a range-for over a
           // member of a temporary would read freed stack memory.)
-          const Quadrature<2> cell_points =
-            cell->reference_cell().get_gauss_type_quadrature<2>(2);
+          const Quadrature<dim> cell_points =
+            kind.template get_gauss_type_quadrature<dim>(2);
           for (const auto &xi : cell_points.get_points())
             check(force,
                   mapping.transform_unit_to_real_cell(cell, xi),
@@ -114,19 +121,21 @@ namespace knee_contact
                     const std::string where =
                       " on boundary id " +
                       std::to_string(cell->face(f)->boundary_id());
-                    const Point<2> a = cell->face(f)->vertex(0),
-                                   b = cell->face(f)->vertex(1);
-                    check(*condition.function,
-                          a,
-                          condition.name + "/Value",
-                          where);
-                    check(*condition.function,
-                          b,
-                          condition.name + "/Value",
-                          where);
-                    for (const auto &s : face_points.get_points())
+                    for (const auto v : cell->face(f)->vertex_indices())
                       check(*condition.function,
-                            Point<2>(a + s[0] * (b - a)),
+                            cell->face(f)->vertex(v),
+                            condition.name + "/Value",
+                            where);
+                    // The face's Gauss points, as the assembly places them.
+                    const Quadrature<dim> face_points =
+                      QProjector<dim>::project_to_face(
+                        kind,
+                        kind.face_reference_cell(f)
+                          .template get_gauss_type_quadrature<dim - 1>(2),
+                        f);
+                    for (const auto &xi : face_points.get_points())
+                      check(*condition.function,
+                            mapping.transform_unit_to_real_cell(cell, xi),
                             condition.name + "/Value",
                             where);
                   }
@@ -135,8 +144,68 @@ namespace knee_contact
 
 
 
+    template <int dim>
     void
-    check_joints(const Triangulation<2>          &triangulation,
+    check_joints(const Triangulation<dim>        &triangulation,
+                 const std::vector<unsigned int> &body_of_cell)
+    {
+      if constexpr (dim == 2)
+        check_cracks(triangulation, body_of_cell);
+
+      // Around each vertex, the cells that share it must be connected
+      // through faces that contain it (Triangulation's vertex_to_cell_map).
+      // (3D: two bodies that share only an edge pass; they are joined along
+      // a line, which a bonded solid does not mean either.)
+      const auto cells_at = GridTools::vertex_to_cell_map(triangulation);
+      for (unsigned int v = 0; v < cells_at.size(); ++v)
+        {
+          if (cells_at[v].size() < 2)
+            continue;
+          std::vector<typename Triangulation<dim>::active_cell_iterator>
+            around(cells_at[v].begin(), cells_at[v].end());
+          std::vector<unsigned int> parent(around.size());
+          std::iota(parent.begin(), parent.end(), 0);
+          const auto find = [&](unsigned int i) {
+            while (parent[i] != i)
+              i = parent[i];
+            return i;
+          };
+          for (unsigned int i = 0; i < around.size(); ++i)
+            for (const auto f : around[i]->face_indices())
+              {
+                if (around[i]->at_boundary(f))
+                  continue;
+                bool contains = false;
+                for (const auto k : around[i]->face(f)->vertex_indices())
+                  contains |= around[i]->face(f)->vertex_index(k) == v;
+                if (contains)
+                  for (unsigned int j = 0; j < around.size(); ++j)
+                    if (around[i]->neighbor(f) == around[j])
+                      parent[find(i)] = find(j);
+              }
+          unsigned int n_groups = 0;
+          for (unsigned int i = 0; i < around.size(); ++i)
+            n_groups += find(i) == i;
+          AssertThrow(n_groups == 1,
+                      ExcMessage("Mesh: cells meet only at the vertex " +
+                                 at(triangulation.get_vertices()[v]) +
+                                 (dim == 2 ? ", not along an edge (bodies "
+                                             "joined at a single point); "
+                                             "bonded parts must share an "
+                                             "edge"
+                                           : ", not along a face (bodies "
+                                             "joined at a single point); "
+                                             "bonded parts must share a "
+                                             "face") +
+                                 ", parts in contact must not share "
+                                 "vertices"));
+        }
+    }
+
+
+
+    void
+    check_cracks(const Triangulation<2>          &triangulation,
                  const std::vector<unsigned int> &body_of_cell)
     {
       // Boundary edges of one body on top of each other: a crack where
@@ -198,42 +267,25 @@ namespace knee_contact
                             "different groups and a contact interface"));
             }
         }
-
-      // Around each vertex, the cells that share it must be connected
-      // through faces that contain it (Triangulation's vertex_to_cell_map).
-      const auto cells_at = GridTools::vertex_to_cell_map(triangulation);
-      for (unsigned int v = 0; v < cells_at.size(); ++v)
-        {
-          if (cells_at[v].size() < 2)
-            continue;
-          std::vector<Triangulation<2>::active_cell_iterator> around(
-            cells_at[v].begin(), cells_at[v].end());
-          std::vector<unsigned int> parent(around.size());
-          std::iota(parent.begin(), parent.end(), 0);
-          const auto find = [&](unsigned int i) {
-            while (parent[i] != i)
-              i = parent[i];
-            return i;
-          };
-          for (unsigned int i = 0; i < around.size(); ++i)
-            for (const auto f : around[i]->face_indices())
-              if (!around[i]->at_boundary(f) &&
-                  (around[i]->face(f)->vertex_index(0) == v ||
-                   around[i]->face(f)->vertex_index(1) == v))
-                for (unsigned int j = 0; j < around.size(); ++j)
-                  if (around[i]->neighbor(f) == around[j])
-                    parent[find(i)] = find(j);
-          unsigned int n_groups = 0;
-          for (unsigned int i = 0; i < around.size(); ++i)
-            n_groups += find(i) == i;
-          AssertThrow(n_groups == 1,
-                      ExcMessage("Mesh: cells meet only at the vertex " +
-                                 at(triangulation.get_vertices()[v]) +
-                                 ", not along an edge (bodies joined at a "
-                                 "single point); bonded parts must share an "
-                                 "edge, parts in contact must not share "
-                                 "vertices"));
-        }
     }
+
+
+
+    template void
+    check_roles(const BoundaryConditions<2> &, const ContactInterfaces &);
+    template void
+    check_roles(const BoundaryConditions<3> &, const ContactInterfaces &);
+    template void
+    check_finite_data(const Triangulation<2> &,
+                      const Materials<2> &,
+                      const BoundaryConditions<2> &);
+    template void
+    check_finite_data(const Triangulation<3> &,
+                      const Materials<3> &,
+                      const BoundaryConditions<3> &);
+    template void
+    check_joints(const Triangulation<2> &, const std::vector<unsigned int> &);
+    template void
+    check_joints(const Triangulation<3> &, const std::vector<unsigned int> &);
   } // namespace scene_checks
 } // namespace knee_contact

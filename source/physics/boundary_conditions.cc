@@ -10,8 +10,9 @@
 
 namespace knee_contact
 {
+  template <int dim>
   void
-  BoundaryConditions::declare_parameters(ParameterHandler  &prm,
+  BoundaryConditions<dim>::declare_parameters(ParameterHandler  &prm,
                                          const unsigned int n_conditions)
   {
     prm.enter_subsection("Boundary conditions");
@@ -27,8 +28,9 @@ namespace knee_contact
         prm.declare_entry("Boundary ids",
                           "",
                           Patterns::List(Patterns::Integer(0, 254)),
-                          "Boundary ids (Gmsh: physical curve tags) this "
-                          "condition applies to.");
+                          "Boundary ids (Gmsh: tags of physical curves in "
+                          "2D, physical surfaces in 3D) this condition "
+                          "applies to.");
         prm.declare_entry(
           "Type",
           "displacement",
@@ -37,16 +39,18 @@ namespace knee_contact
           "Gamma_tau; pressure: tau.n = -p n (p > 0 pushes into the body); "
           "sliding: u.n = 0 and zero tangential traction on Gamma_o.");
         prm.declare_entry("Components",
-                          "x, y",
-                          Patterns::MultipleSelection("x|y"),
+                          dim == 2 ? "x, y" : "x, y, z",
+                          Patterns::MultipleSelection(dim == 2 ? "x|y"
+                                                               : "x|y|z"),
                           "For displacement: the components of u0 that are "
                           "prescribed; the others stay free.");
         prm.declare_entry("Value",
-                          "0; 0",
+                          dim == 2 ? "0; 0" : "0; 0; 0",
                           Patterns::Anything(),
                           "Expression in x, y [m]: u0 = (u_x; u_y) [m] for "
                           "displacement, P = (P_x; P_y) [Pa] for traction, "
-                          "p [Pa] for pressure; unused for sliding.");
+                          "p [Pa] for pressure; unused for sliding. In 3D "
+                          "three components in x, y, z.");
         prm.leave_subsection();
       }
     prm.leave_subsection();
@@ -54,15 +58,16 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  BoundaryConditions::parse_parameters(ParameterHandler  &prm,
+  BoundaryConditions<dim>::parse_parameters(ParameterHandler  &prm,
                                        const unsigned int n_conditions)
   {
     prm.enter_subsection("Boundary conditions");
     std::map<types::boundary_id, std::string> used;
     for (unsigned int c = 0; c < n_conditions; ++c)
       {
-        BoundaryCondition condition;
+        BoundaryCondition<dim> condition;
         condition.name = "Boundary conditions/Condition " + std::to_string(c);
         prm.enter_subsection("Condition " + std::to_string(c));
         const std::string type = prm.get("Type");
@@ -86,17 +91,18 @@ namespace knee_contact
         AssertThrow(!condition.ids.empty(),
                     ExcMessage(condition.name + "/Boundary ids: empty list"));
         const std::string components = prm.get("Components");
-        condition.mask               = ComponentMask(
-          std::vector<bool>{components.find('x') != std::string::npos,
-                                          components.find('y') != std::string::npos});
+        std::vector<bool> selected(dim);
+        for (unsigned int d = 0; d < dim; ++d)
+          selected[d] = components.find("xyz"[d]) != std::string::npos;
+        condition.mask = ComponentMask(selected);
         AssertThrow(condition.type != BoundaryType::displacement ||
                       condition.mask.n_selected_components() > 0,
                     ExcMessage(condition.name +
                                "/Components: no component selected"));
         if (condition.type != BoundaryType::sliding)
-          condition.function = input::parse_expression(
+          condition.function = input::parse_expression<dim>(
             prm.get("Value"),
-            condition.type == BoundaryType::pressure ? 1 : 2,
+            condition.type == BoundaryType::pressure ? 1 : dim,
             condition.name + "/Value",
             "",
             condition.type != BoundaryType::displacement);
@@ -108,8 +114,9 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  BoundaryConditions::check_mesh(const Triangulation<2> &triangulation) const
+  BoundaryConditions<dim>::check_mesh(const Triangulation<dim> &triangulation) const
   {
     const auto ids = triangulation.get_boundary_ids();
     for (const auto &condition : list)
@@ -123,13 +130,17 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  BoundaryConditions::make_constraints(
-    const DoFHandler<2>       &dof_handler,
+  BoundaryConditions<dim>::make_constraints(
+    const DoFHandler<dim>     &dof_handler,
     AffineConstraints<double> &constraints) const
   {
-    // Hanging nodes of adaptive refinement first; in 2D they never lie on
-    // the boundary, so they do not meet the lines below.
+    // Hanging nodes of adaptive refinement first. In 2D they never lie on
+    // the boundary; in 3D they can, and the boundary values below are then
+    // left out for them (AffineConstraints keeps the first constraint of a
+    // dof), so that the hanging node follows its parents, which carry the
+    // boundary values.
     constraints.clear();
     DoFTools::make_hanging_node_constraints(dof_handler, constraints);
     for (const auto &condition : list)
@@ -165,12 +176,19 @@ namespace knee_contact
   }
 
 
+  template <int dim>
   void
-  BoundaryConditions::set_load_parameter(const double t)
+  BoundaryConditions<dim>::set_load_parameter(const double t)
   {
     for (auto &condition : list)
       if (condition.type == BoundaryType::traction ||
           condition.type == BoundaryType::pressure)
         condition.function->set_time(t);
   }
+
+
+  template struct BoundaryCondition<2>;
+  template struct BoundaryCondition<3>;
+  template class BoundaryConditions<2>;
+  template class BoundaryConditions<3>;
 } // namespace knee_contact

@@ -10,9 +10,10 @@ namespace knee_contact
 {
   namespace
   {
+    template <int dim>
     struct ScratchData
     {
-      ScratchData(const DoFHandler<2> &dof_handler)
+      ScratchData(const DoFHandler<dim> &dof_handler)
         : fe_values(elements::mapping(dof_handler),
                     dof_handler.get_fe(),
                     elements::cell_quadrature(dof_handler, 2),
@@ -24,7 +25,7 @@ namespace knee_contact
                             update_gradients | update_JxW_values)
         , fe_face_values(elements::mapping(dof_handler),
                          dof_handler.get_fe(),
-                         QGauss<1>(2),
+                         elements::face_quadrature(dof_handler, 2),
                          update_values | update_quadrature_points |
                            update_normal_vectors | update_JxW_values)
       {}
@@ -44,9 +45,9 @@ namespace knee_contact
                          other.fe_face_values.get_update_flags())
       {}
 
-      FEValues<2>     fe_values;
-      FEValues<2>     fe_values_reduced;
-      FEFaceValues<2> fe_face_values;
+      FEValues<dim>     fe_values;
+      FEValues<dim>     fe_values_reduced;
+      FEFaceValues<dim> fe_face_values;
     };
 
     struct CopyData
@@ -59,17 +60,19 @@ namespace knee_contact
 
 
 
-  ElasticityAssembler::ElasticityAssembler(
-    const Materials          &materials,
-    const BoundaryConditions &boundary_conditions)
+  template <int dim>
+  ElasticityAssembler<dim>::ElasticityAssembler(
+    const Materials<dim>          &materials,
+    const BoundaryConditions<dim> &boundary_conditions)
     : materials(materials)
     , boundary_conditions(boundary_conditions)
   {}
 
 
 
+  template <int dim>
   void
-  ElasticityAssembler::assemble(const DoFHandler<2>  &dof_handler,
+  ElasticityAssembler<dim>::assemble(const DoFHandler<dim>  &dof_handler,
                                 SparseMatrix<double> &matrix,
                                 Vector<double>       &rhs) const
   {
@@ -79,8 +82,9 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  ElasticityAssembler::assemble_rhs(const DoFHandler<2> &dof_handler,
+  ElasticityAssembler<dim>::assemble_rhs(const DoFHandler<dim> &dof_handler,
                                     Vector<double>      &rhs) const
   {
     assemble(dof_handler, nullptr, rhs);
@@ -88,8 +92,9 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  ElasticityAssembler::assemble(const DoFHandler<2>  &dof_handler,
+  ElasticityAssembler<dim>::assemble(const DoFHandler<dim>  &dof_handler,
                                 SparseMatrix<double> *matrix,
                                 Vector<double>       &rhs) const
   {
@@ -99,12 +104,12 @@ namespace knee_contact
     // a(u, v) = int e(v) : c : e(u) dx and L(v) = int F.v dx + int P.v ds,
     // the seed's eq. (5), cell by cell.
     const auto worker = [this, with_matrix](
-                          const DoFHandler<2>::active_cell_iterator &cell,
-                          ScratchData                               &scratch,
+                          const typename DoFHandler<dim>::active_cell_iterator &cell,
+                          ScratchData<dim>                          &scratch,
                           CopyData                                  &copy) {
-      const FiniteElement<2> &fe       = cell->get_fe();
-      const unsigned int      n        = fe.n_dofs_per_cell();
-      const Material         &material = materials[cell->material_id()];
+      const FiniteElement<dim> &fe       = cell->get_fe();
+      const unsigned int        n        = fe.n_dofs_per_cell();
+      const Material<dim>      &material = materials[cell->material_id()];
       copy.cell_matrix.reinit(n, n);
       copy.cell_rhs.reinit(n);
       copy.dof_indices.resize(n);
@@ -114,8 +119,8 @@ namespace knee_contact
       const bool volume = with_matrix || !material.body_force_is_zero;
       if (volume)
         scratch.fe_values.reinit(cell);
-      const FEValues<2> &fev = scratch.fe_values;
-      Vector<double>     force(2);
+      const FEValues<dim> &fev = scratch.fe_values;
+      Vector<double>       force(dim);
       for (unsigned int q = 0; volume && q < fev.n_quadrature_points; ++q)
         {
           if (!material.body_force_is_zero)
@@ -123,11 +128,11 @@ namespace knee_contact
           for (unsigned int i = 0; i < n; ++i)
             {
               const unsigned int ci = fe.system_to_component_index(i).first;
-              const Tensor<1, 2> gi = fev.shape_grad(i, q);
+              const Tensor<1, dim> gi = fev.shape_grad(i, q);
               for (unsigned int j = 0; with_matrix && j < n; ++j)
                 {
                   const unsigned int cj = fe.system_to_component_index(j).first;
-                  const Tensor<1, 2> gj = fev.shape_grad(j, q);
+                  const Tensor<1, dim> gj = fev.shape_grad(j, q);
                   // c_ijkl for isotropic material, written per component
                   // pair as in step-8.
                   const double lambda =
@@ -145,7 +150,7 @@ namespace knee_contact
       if (with_matrix && material.reduced_volumetric)
         {
           scratch.fe_values_reduced.reinit(cell);
-          const FEValues<2> &fer = scratch.fe_values_reduced;
+          const FEValues<dim> &fer = scratch.fe_values_reduced;
           for (const unsigned int q : fer.quadrature_point_indices())
             for (unsigned int i = 0; i < n; ++i)
               for (unsigned int j = 0; j < n; ++j)
@@ -163,16 +168,16 @@ namespace knee_contact
                 condition.ids.count(cell->face(f)->boundary_id()))
               {
                 scratch.fe_face_values.reinit(cell, f);
-                const FEFaceValues<2> &fv = scratch.fe_face_values;
+                const FEFaceValues<dim> &fv = scratch.fe_face_values;
                 for (const unsigned int q : fv.quadrature_point_indices())
                   {
-                    Tensor<1, 2> traction;
+                    Tensor<1, dim> traction;
                     if (condition.type == BoundaryType::pressure)
                       traction =
                         -condition.function->value(fv.quadrature_point(q)) *
                         fv.normal_vector(q);
                     else
-                      for (unsigned int d = 0; d < 2; ++d)
+                      for (unsigned int d = 0; d < dim; ++d)
                         traction[d] =
                           condition.function->value(fv.quadrature_point(q), d);
                     for (unsigned int i = 0; i < n; ++i)
@@ -194,7 +199,11 @@ namespace knee_contact
                     dof_handler.end(),
                     worker,
                     copier,
-                    ScratchData(dof_handler),
+                    ScratchData<dim>(dof_handler),
                     CopyData());
   }
+
+
+  template class ElasticityAssembler<2>;
+  template class ElasticityAssembler<3>;
 } // namespace knee_contact

@@ -10,37 +10,48 @@
 
 namespace knee_contact
 {
-  SymmetricTensor<2, 2>
-  Material::stress(const SymmetricTensor<2, 2> &strain) const
+  template <int dim>
+  SymmetricTensor<2, dim>
+  Material<dim>::stress(const SymmetricTensor<2, dim> &strain) const
   {
-    return lambda * trace(strain) * unit_symmetric_tensor<2>() +
+    return lambda * trace(strain) * unit_symmetric_tensor<dim>() +
            2. * mu * strain;
   }
 
 
 
+  template <int dim>
   double
-  Material::stress_zz(const SymmetricTensor<2, 2> &stress) const
+  Material<dim>::stress_zz(const SymmetricTensor<2, dim> &stress) const
   {
+    if constexpr (dim == 3)
+      return stress[2][2];
     return plane_strain ? poissons_ratio * trace(stress) : 0.;
   }
 
 
 
+  template <int dim>
   double
-  Material::von_mises(const SymmetricTensor<2, 2> &s) const
+  Material<dim>::von_mises(const SymmetricTensor<2, dim> &s) const
   {
-    const double szz = stress_zz(s);
+    // sqrt(3/2 s_dev : s_dev), written out as in the textbooks so that the
+    // 2D case can add tau_zz.
+    const double szz   = stress_zz(s);
+    double       shear = s[0][1] * s[0][1];
+    if constexpr (dim == 3)
+      shear += s[1][2] * s[1][2] + s[0][2] * s[0][2];
     return std::sqrt(0.5 * ((s[0][0] - s[1][1]) * (s[0][0] - s[1][1]) +
                             (s[1][1] - szz) * (s[1][1] - szz) +
                             (szz - s[0][0]) * (szz - s[0][0])) +
-                     3. * s[0][1] * s[0][1]);
+                     3. * shear);
   }
 
 
 
+  template <int dim>
   void
-  Materials::declare_parameters(ParameterHandler  &prm,
+  Materials<dim>::declare_parameters(ParameterHandler  &prm,
                                 const unsigned int n_materials)
   {
     prm.enter_subsection("Materials");
@@ -53,15 +64,15 @@ namespace knee_contact
                       "strain",
                       Patterns::Selection("strain|stress"),
                       "2D model: plane strain (e_zz = 0, the default) or "
-                      "plane stress (tau_zz = 0).");
+                      "plane stress (tau_zz = 0); unused in 3D.");
     for (unsigned int m = 0; m < n_materials; ++m)
       {
         prm.enter_subsection("Material " + std::to_string(m));
         prm.declare_entry("Material id",
                           std::to_string(m + 1),
                           Patterns::Integer(0, 254),
-                          "Material id of the cells (Gmsh: the physical "
-                          "surface's tag).");
+                          "Material id of the cells (Gmsh: the tag of the "
+                          "physical surface in 2D, physical volume in 3D).");
         prm.declare_entry("Name",
                           "material " + std::to_string(m + 1),
                           Patterns::Anything(),
@@ -77,15 +88,17 @@ namespace knee_contact
         prm.declare_entry("Volumetric integration",
                           "full",
                           Patterns::Selection("full|reduced"),
-                          "full: 2x2 Gauss points for the whole stiffness; "
+                          "full: 2 Gauss points per direction for the whole "
+                          "stiffness; "
                           "reduced: the volumetric part lambda div u div v "
                           "with one point (selective reduced integration), "
                           "against locking when nu is close to 0.5.");
         prm.declare_entry("Body force",
-                          "0; 0",
+                          dim == 2 ? "0; 0" : "0; 0; 0",
                           Patterns::Anything(),
                           "Body force F = (F_x; F_y) [N/m^3] of the seed's "
-                          "eq. (1), an expression in x, y [m].");
+                          "eq. (1), an expression in x, y [m]; in 3D "
+                          "(F_x; F_y; F_z) in x, y, z.");
         prm.leave_subsection();
       }
     prm.leave_subsection();
@@ -93,8 +106,9 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  Materials::parse_parameters(ParameterHandler  &prm,
+  Materials<dim>::parse_parameters(ParameterHandler  &prm,
                               const unsigned int n_materials)
   {
     prm.enter_subsection("Materials");
@@ -109,7 +123,7 @@ namespace knee_contact
                     ExcMessage("Materials/" + section + ": material id " +
                                std::to_string(id) +
                                " is given to more than one material"));
-        Material &material = materials[id];
+        Material<dim> &material = materials[id];
         material.name      = prm.get("Name");
         input::check_name(material.name, "Materials/" + section + "/Name");
         for (const auto &[other_id, other] : materials)
@@ -143,16 +157,16 @@ namespace knee_contact
                                prm.get("Poisson's ratio")));
         material.mu     = E / (2 * (1 + nu));
         material.lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
-        if (!plane_strain)
+        if (dim == 2 && !plane_strain)
           material.lambda = 2 * material.lambda * material.mu /
                             (material.lambda + 2 * material.mu);
         material.body_force =
-          input::parse_expression(prm.get("Body force"),
-                                  2,
+          input::parse_expression<dim>(prm.get("Body force"),
+                                       dim,
                                   "Materials/" + section + "/Body force",
                                   "",
                                   true);
-        // Written as zeros ("0; 0", the default): assembly skips it.
+        // Written as zeros ("0; 0", the 2D default): assembly skips it.
         material.body_force_is_zero = true;
         for (const auto &part : input::split(prm.get("Body force"), ';'))
           {
@@ -185,8 +199,9 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  Materials::check_mesh(const Triangulation<2> &triangulation) const
+  Materials<dim>::check_mesh(const Triangulation<dim> &triangulation) const
   {
     for (const auto &cell : triangulation.active_cell_iterators())
       AssertThrow(materials.find(cell->material_id()) != materials.end(),
@@ -198,8 +213,9 @@ namespace knee_contact
 
 
 
-  const Material &
-  Materials::operator[](const types::material_id id) const
+  template <int dim>
+  const Material<dim> &
+  Materials<dim>::operator[](const types::material_id id) const
   {
     const auto it = materials.find(id);
     Assert(it != materials.end(), ExcInternalError());
@@ -208,8 +224,9 @@ namespace knee_contact
 
 
 
+  template <int dim>
   double
-  Materials::min_youngs_modulus() const
+  Materials<dim>::min_youngs_modulus() const
   {
     double E = std::numeric_limits<double>::max();
     for (const auto &m : materials)
@@ -219,8 +236,9 @@ namespace knee_contact
 
 
 
+  template <int dim>
   double
-  Materials::max_youngs_modulus() const
+  Materials<dim>::max_youngs_modulus() const
   {
     double E = 0;
     for (const auto &m : materials)
@@ -229,10 +247,17 @@ namespace knee_contact
   }
 
 
+  template <int dim>
   void
-  Materials::set_load_parameter(const double t)
+  Materials<dim>::set_load_parameter(const double t)
   {
     for (auto &m : materials)
       m.second.body_force->set_time(t);
   }
+
+
+  template struct Material<2>;
+  template struct Material<3>;
+  template class Materials<2>;
+  template class Materials<3>;
 } // namespace knee_contact

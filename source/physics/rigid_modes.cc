@@ -1,6 +1,8 @@
 #include <knee_contact/physics/elements.h>
 #include <knee_contact/physics/rigid_modes.h>
 
+#include <deal.II/base/tensor.h>
+
 #include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/lapack_full_matrix.h>
 
@@ -12,9 +14,10 @@
 
 namespace knee_contact
 {
-  RigidModes::RigidModes(const DoFHandler<2>             &dof_handler,
-                         const std::vector<unsigned int> &body_of_cell,
-                         const std::vector<std::string>  &body_names)
+  template <int dim>
+  RigidModes<dim>::RigidModes(const DoFHandler<dim>           &dof_handler,
+                              const std::vector<unsigned int> &body_of_cell,
+                              const std::vector<std::string>  &body_names)
     : dof_body(dof_handler.n_dofs())
     , dof_component(dof_handler.n_dofs())
     , dof_position(dof_handler.n_dofs())
@@ -27,8 +30,11 @@ namespace knee_contact
                                          dof_position);
     std::vector<types::global_dof_index> dofs(
       dof_handler.get_fe().n_dofs_per_cell());
-    std::vector<Point<2>> lower(names.size(), Point<2>(1e300, 1e300)),
-      upper(names.size(), Point<2>(-1e300, -1e300));
+    Point<dim> huge;
+    for (unsigned int d = 0; d < dim; ++d)
+      huge[d] = 1e300;
+    std::vector<Point<dim>> lower(names.size(), huge),
+      upper(names.size(), -huge);
     for (const auto &cell : dof_handler.active_cell_iterators())
       {
         const unsigned int body = body_of_cell[cell->active_cell_index()];
@@ -38,7 +44,7 @@ namespace knee_contact
             dof_body[dofs[i]] = body;
             dof_component[dofs[i]] =
               dof_handler.get_fe().system_to_component_index(i).first;
-            for (unsigned int d = 0; d < 2; ++d)
+            for (unsigned int d = 0; d < dim; ++d)
               {
                 lower[body][d] =
                   std::min(lower[body][d], dof_position[dofs[i]][d]);
@@ -57,47 +63,57 @@ namespace knee_contact
 
 
   void
-  RigidModes::check(const AffineConstraints<double> &base,
-                    const std::vector<ContactPair>  &pairs,
-                    const std::vector<bool>         &active,
-                    const std::string               &context) const
+  RigidModeCheck::check(const AffineConstraints<double> &base,
+                        const std::vector<ContactRow>   &rows,
+                        const std::vector<bool>         &active,
+                        const std::string               &context) const
   {
-    const std::string motion = free_motion(base, pairs, active);
+    const std::string motion = free_motion(base, rows, active);
     AssertThrow(motion.empty(), ExcMessage(motion + "; " + context));
   }
 
 
 
+  template <int dim>
   std::string
-  RigidModes::free_motion(const AffineConstraints<double> &base,
-                          const std::vector<ContactPair>  &pairs,
-                          const std::vector<bool>         &active) const
+  RigidModes<dim>::free_motion(const AffineConstraints<double> &base,
+                               const std::vector<ContactRow>   &pairs,
+                               const std::vector<bool>         &active) const
   {
-    const unsigned int n_modes = 3 * names.size();
-    FullMatrix<double> gram(n_modes, n_modes);
-    Vector<double>     w(n_modes);
+    const unsigned int n_all = n_modes * names.size();
+    FullMatrix<double> gram(n_all, n_all);
+    Vector<double>     w(n_all);
 
     // Add one homogeneous constraint row sum_d v_d x_d = 0 to the Gram
-    // matrix, evaluated on mode (b, k): translation x, translation y, and
-    // rotation about the body's centre scaled by its size.
+    // matrix, evaluated on the modes of body b: the translations along the
+    // axes, then the rotations about the axes through the body's centre
+    // (2D: about z only), e_k x (x - centre), scaled by its size.
     const auto add_row =
       [&](const std::vector<std::pair<types::global_dof_index, double>> &row) {
         w           = 0;
         double norm = 0;
         for (const auto &[dof, v] : row)
           {
-            const unsigned int b = dof_body[dof];
-            const unsigned int c = dof_component[dof];
-            const Point<2>    &x = dof_position[dof];
-            w(3 * b + c) += v;
-            w(3 * b + 2) +=
-              v * (c == 0 ? -(x[1] - centre[b][1]) : (x[0] - centre[b][0])) /
-              size[b];
+            const unsigned int    b = dof_body[dof];
+            const unsigned int    c = dof_component[dof];
+            const Tensor<1, dim> r = dof_position[dof] - centre[b];
+            w(n_modes * b + c) += v;
+            if constexpr (dim == 2)
+              w(n_modes * b + 2) += v * (c == 0 ? -r[1] : r[0]) / size[b];
+            else
+              // (e_k x r)_c = epsilon_kjc r_j: nonzero for j, k, c distinct.
+              for (unsigned int k = 0; k < 3; ++k)
+                if (k != c)
+                  {
+                    const unsigned int j = 3 - k - c;
+                    const double sign = (k + 1) % 3 == j ? 1. : -1.;
+                    w(n_modes * b + 3 + k) += v * sign * r[j] / size[b];
+                  }
             norm += v * v;
           }
         if (norm > 0)
-          for (unsigned int i = 0; i < n_modes; ++i)
-            for (unsigned int j = 0; j < n_modes; ++j)
+          for (unsigned int i = 0; i < n_all; ++i)
+            for (unsigned int j = 0; j < n_all; ++j)
               gram(i, j) += w(i) * w(j) / norm;
       };
 
@@ -113,10 +129,10 @@ namespace knee_contact
       if (active[p])
         add_row(pairs[p].row);
 
-    LAPACKFullMatrix<double> matrix(n_modes);
+    LAPACKFullMatrix<double> matrix(n_all);
     matrix         = gram;
     double largest = 0;
-    for (unsigned int i = 0; i < n_modes; ++i)
+    for (unsigned int i = 0; i < n_all; ++i)
       largest = std::max(largest, gram(i, i));
     Vector<double>     eigenvalues;
     FullMatrix<double> eigenvectors;
@@ -132,37 +148,64 @@ namespace knee_contact
     for (unsigned int b = 0; b < names.size(); ++b)
       {
         double m = 0;
-        for (unsigned int k = 0; k < 3; ++k)
-          m += eigenvectors(3 * b + k, 0) * eigenvectors(3 * b + k, 0);
+        for (unsigned int k = 0; k < n_modes; ++k)
+          m += eigenvectors(n_modes * b + k, 0) * eigenvectors(n_modes * b + k, 0);
         if (m > largest_motion + 1e-12)
           {
             largest_motion = m;
             body           = b;
           }
       }
-    const double       tx    = eigenvectors(3 * body, 0);
-    const double       ty    = eigenvectors(3 * body + 1, 0);
-    const double       omega = eigenvectors(3 * body + 2, 0) / size[body];
+    // u(x) = t + omega x (x - centre), omega along z in 2D.
+    Tensor<1, dim> t;
+    Tensor<1, 3>   omega;
+    for (unsigned int d = 0; d < dim; ++d)
+      t[d] = eigenvectors(n_modes * body + d, 0);
+    for (unsigned int k = 0; k < n_modes - dim; ++k)
+      omega[dim == 2 ? 2 : k] =
+        eigenvectors(n_modes * body + dim + k, 0) / size[body];
     std::ostringstream motion;
     motion.precision(4);
-    const double t = std::sqrt(tx * tx + ty * ty);
-    if (std::abs(omega) * size[body] > 1e-6 * t)
-      // A rotation omega about p moves x by omega (-(y - p_y), x - p_x):
-      // the same as rotation about the centre plus a translation.
-      motion << "rotation about (" << centre[body][0] - ty / omega << ", "
-             << centre[body][1] + tx / omega << ")";
-    else
+    // Components at round-off of a unit direction are shown as 0.
+    const auto shown = [](const double c) {
+      return std::abs(c) < 1e-12 ? 0. : c;
+    };
+    const auto list = [&](const auto &v, const double scale) {
+      std::ostringstream out;
+      out.precision(4);
+      for (unsigned int d = 0; d < dim; ++d)
+        out << (d == 0 ? "(" : ", ") << shown(v[d] / scale);
+      out << ")";
+      return out.str();
+    };
+    if (omega.norm() * size[body] > 1e-6 * t.norm())
       {
-        // Components at round-off of the unit direction are shown as 0.
-        const auto shown = [](const double c) {
-          return std::abs(c) < 1e-12 ? 0. : c;
-        };
-        motion << "translation along (" << shown(tx / t) << ", "
-               << shown(ty / t) << ")";
+        // The axis: the points p where u(p) is parallel to omega,
+        // p = centre + omega x t / |omega|^2 (2D: the centre of rotation).
+        Tensor<1, 3> t3;
+        for (unsigned int d = 0; d < dim; ++d)
+          t3[d] = t[d];
+        const Tensor<1, 3> offset =
+          cross_product_3d(omega, t3) / (omega * omega);
+        Point<dim> p = centre[body];
+        for (unsigned int d = 0; d < dim; ++d)
+          p[d] += offset[d];
+        if constexpr (dim == 2)
+          motion << "rotation about (" << p[0] << ", " << p[1] << ")";
+        else
+          motion << "rotation about the axis through (" << p[0] << ", "
+                 << p[1] << ", " << p[2] << ") along "
+                 << list(omega, omega.norm());
       }
+    else
+      motion << "translation along " << list(t, t.norm());
     return "body " + std::to_string(body) + " (" + names[body] +
            ") is not held: its " + motion.str() +
            " is free of every displacement, sliding and active contact "
            "constraint";
   }
+
+
+  template class RigidModes<2>;
+  template class RigidModes<3>;
 } // namespace knee_contact

@@ -84,30 +84,36 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  LoadCases::write_csv(const std::vector<Record> &records, std::ostream &out)
+  LoadCases::write_csv(const std::vector<Record<dim>> &records,
+                       std::ostream                   &out)
   {
     if (records.empty())
       return;
-    const Results &first = records.front().results;
-    out << "case,t,iterations,converged,solve_time,energy,max_displacement,"
-           "load_x,load_y";
+    const Results<dim> &first = records.front().results;
+    out << "case,t,iterations,converged,solve_time,energy,max_displacement";
+    for (unsigned int d = 0; d < dim; ++d)
+      out << ",load_" << "xyz"[d];
     for (const auto &[id, reaction] : first.reactions)
-      out << ",reaction_" << id << "_x,reaction_" << id << "_y";
+      for (unsigned int d = 0; d < dim; ++d)
+        out << ",reaction_" << id << '_' << "xyz"[d];
     for (const auto &i : first.interfaces)
       out << ',' << i.name << "_active_pairs," << i.name << "_force," << i.name
           << "_peak_pressure," << i.name << "_contact_length";
     out << '\n' << std::setprecision(12);
     for (unsigned int c = 0; c < records.size(); ++c)
       {
-        const Record  &r       = records[c];
-        const Results &results = r.results;
+        const Record<dim>  &r       = records[c];
+        const Results<dim> &results = r.results;
         out << c << ',' << r.t << ',' << r.n_iterations << ','
             << (r.converged ? "true" : "false") << ',' << r.solve_time << ','
-            << results.energy << ',' << results.max_displacement << ','
-            << results.applied_load[0] << ',' << results.applied_load[1];
+            << results.energy << ',' << results.max_displacement;
+        for (unsigned int d = 0; d < dim; ++d)
+          out << ',' << results.applied_load[d];
         for (const auto &[id, reaction] : results.reactions)
-          out << ',' << reaction[0] << ',' << reaction[1];
+          for (unsigned int d = 0; d < dim; ++d)
+            out << ',' << reaction[d];
         for (const auto &i : results.interfaces)
           out << ',' << i.n_active << ',' << i.force << ',' << i.max_pressure
               << ',' << i.contact_length;
@@ -117,10 +123,11 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  LoadCases::print_table(const std::vector<Record> &records,
-                         const bool                 with_times,
-                         std::ostream              &out)
+  LoadCases::print_table(const std::vector<Record<dim>> &records,
+                         const bool                      with_times,
+                         std::ostream                   &out)
   {
     out << "load cases:\n"
         << "  case          t  iterations  energy [J/m]  peak pressure [Pa]"
@@ -128,7 +135,7 @@ namespace knee_contact
         << (with_times ? "  solve [s]" : "") << '\n';
     for (unsigned int c = 0; c < records.size(); ++c)
       {
-        const Record &r    = records[c];
+        const Record<dim> &r = records[c];
         double        peak = 0, length = 0;
         for (const auto &i : r.results.interfaces)
           {
@@ -146,4 +153,18 @@ namespace knee_contact
       }
     out << std::flush;
   }
+
+
+  template void
+  LoadCases::write_csv(const std::vector<Record<2>> &, std::ostream &);
+  template void
+  LoadCases::write_csv(const std::vector<Record<3>> &, std::ostream &);
+  template void
+  LoadCases::print_table(const std::vector<Record<2>> &,
+                         const bool,
+                         std::ostream &);
+  template void
+  LoadCases::print_table(const std::vector<Record<3>> &,
+                         const bool,
+                         std::ostream &);
 } // namespace knee_contact

@@ -73,41 +73,51 @@ namespace knee_contact
           return candidate.lexically_normal().string();
       return "";
     }
-    // tau_xx, tau_yy, tau_xy and von Mises of each cell's material, from the
-    // displacement gradient.
-    class StressPostprocessor : public DataPostprocessor<2>
+    // The stress components (2D: tau_xx, tau_yy, tau_xy; 3D: tau_xx,
+    // tau_yy, tau_zz, tau_xy, tau_xz, tau_yz) and von Mises of each cell's
+    // material, from the displacement gradient.
+    template <int dim>
+    class StressPostprocessor : public DataPostprocessor<dim>
     {
     public:
-      StressPostprocessor(const Materials &materials)
+      StressPostprocessor(const Materials<dim> &materials)
         : materials(materials)
       {}
 
       void
       evaluate_vector_field(
-        const DataPostprocessorInputs::Vector<2> &inputs,
-        std::vector<Vector<double>>              &computed) const override
+        const DataPostprocessorInputs::Vector<dim> &inputs,
+        std::vector<Vector<double>>                &computed) const override
       {
-        const auto      cell     = inputs.template get_cell<2>();
-        const Material &material = materials[cell->material_id()];
+        const auto           cell     = inputs.template get_cell<dim>();
+        const Material<dim> &material = materials[cell->material_id()];
+        const auto           order    = components();
         for (unsigned int q = 0; q < computed.size(); ++q)
           {
-            SymmetricTensor<2, 2> strain;
-            for (unsigned int i = 0; i < 2; ++i)
-              for (unsigned int j = i; j < 2; ++j)
+            SymmetricTensor<2, dim> strain;
+            for (unsigned int i = 0; i < dim; ++i)
+              for (unsigned int j = i; j < dim; ++j)
                 strain[i][j] = 0.5 * (inputs.solution_gradients[q][i][j] +
                                       inputs.solution_gradients[q][j][i]);
             const auto stress = material.stress(strain);
-            computed[q](0)    = stress[0][0];
-            computed[q](1)    = stress[1][1];
-            computed[q](2)    = stress[0][1];
-            computed[q](3)    = material.von_mises(stress);
+            for (unsigned int c = 0; c < order.size(); ++c)
+              computed[q](c) = stress[order[c].first][order[c].second];
+            computed[q](order.size()) = material.von_mises(stress);
           }
       }
 
       std::vector<std::string>
       get_names() const override
       {
-        return {"stress_xx", "stress_yy", "stress_xy", "von_mises"};
+        if constexpr (dim == 2)
+          return {"stress_xx", "stress_yy", "stress_xy", "von_mises"};
+        return {"stress_xx",
+                "stress_yy",
+                "stress_zz",
+                "stress_xy",
+                "stress_xz",
+                "stress_yz",
+                "von_mises"};
       }
 
       UpdateFlags
@@ -117,14 +127,48 @@ namespace knee_contact
       }
 
     private:
-      const Materials &materials;
+      static std::vector<std::pair<unsigned int, unsigned int>>
+      components()
+      {
+        if constexpr (dim == 2)
+          return {{0, 0}, {1, 1}, {0, 1}};
+        return {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
+      }
+
+      const Materials<dim> &materials;
     };
+
+    // A NumPy .npy file (format 1.0, little-endian float32) of @p data with
+    // @p n_columns columns.
+    void
+    write_npy(std::ostream             &out,
+              const std::vector<float> &data,
+              const unsigned int        n_columns)
+    {
+      std::string header = "{'descr': '<f4', 'fortran_order': False, "
+                           "'shape': (" +
+                           std::to_string(data.size() / n_columns) + ", " +
+                           std::to_string(n_columns) + "), }";
+      // Magic, version 1.0, header length; header padded with spaces and a
+      // newline so that the data starts at a multiple of 64 bytes.
+      const std::size_t total = 10 + header.size() + 1;
+      header += std::string((64 - total % 64) % 64, ' ') + "\n";
+      const std::uint16_t length = header.size();
+      out.write("\x93NUMPY\x01\x00", 8);
+      out.put(static_cast<char>(length & 0xff));
+      out.put(static_cast<char>(length >> 8));
+      out << header;
+      static_assert(sizeof(float) == 4, "float32 expected");
+      out.write(reinterpret_cast<const char *>(data.data()),
+                data.size() * sizeof(float));
+    }
   } // namespace
 
 
 
+  template <int dim>
   void
-  OutputWriter::declare_parameters(ParameterHandler &prm)
+  OutputWriter<dim>::declare_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Output");
     prm.declare_entry("Folder",
@@ -147,13 +191,15 @@ namespace knee_contact
                       "true",
                       Patterns::Bool(),
                       "Draw deformation.png, stress_yy.png and "
-                      "contact_pressure.png with matplotlib (needs Write "
+                      "contact_pressure.png (3D: von_mises.png, the deformed "
+                      "surface from two views) with matplotlib (needs Write "
                       "files).");
     prm.declare_entry("Labels",
                       "",
                       Patterns::Anything(),
                       "Points labelled in deformation.png: 'name: x, y; ...' "
-                      "[m], e.g. the seed's points 1-10.");
+                      "[m], e.g. the seed's points 1-10 (3D: 'name: x, y, "
+                      "z').");
     prm.declare_entry("Picture time limit",
                       "600",
                       Patterns::Double(1),
@@ -169,8 +215,9 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  OutputWriter::parse_parameters(ParameterHandler  &prm,
+  OutputWriter<dim>::parse_parameters(ParameterHandler  &prm,
                                  const std::string &scene_file)
   {
     prm.enter_subsection("Output");
@@ -185,14 +232,16 @@ namespace knee_contact
     picture_time_limit = prm.get_double("Picture time limit");
     for (const auto &[name, point] :
          input::split_named(prm.get("Labels"), "Output/Labels", "name: x, y"))
-      labels.emplace_back(name, input::to_point(point, "Output/Labels"));
+      labels.emplace_back(name,
+                          input::to_point<dim>(point, "Output/Labels"));
     prm.leave_subsection();
   }
 
 
 
+  template <int dim>
   void
-  OutputWriter::prepare()
+  OutputWriter<dim>::prepare()
   {
     if (write_files)
       result_folder = std::make_unique<ResultFolder>(output_folder);
@@ -200,8 +249,9 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  OutputWriter::commit()
+  OutputWriter<dim>::commit()
   {
     if (result_folder)
       result_folder->commit();
@@ -210,8 +260,9 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  OutputWriter::warn(const std::string &message)
+  OutputWriter<dim>::warn(const std::string &message)
   {
     std::cout << "warning: " << message << std::endl;
     warnings.push_back(message);
@@ -219,8 +270,9 @@ namespace knee_contact
 
 
 
+  template <int dim>
   std::string
-  OutputWriter::staging(const std::string &name) const
+  OutputWriter<dim>::staging(const std::string &name) const
   {
     Assert(result_folder, ExcInternalError());
     return result_folder->staging() + "/" + subfolder + name;
@@ -228,16 +280,18 @@ namespace knee_contact
 
 
 
+  template <int dim>
   std::string
-  OutputWriter::final_path(const std::string &name) const
+  OutputWriter<dim>::final_path(const std::string &name) const
   {
     return output_folder + "/" + subfolder + name;
   }
 
 
 
+  template <int dim>
   void
-  OutputWriter::set_subfolder(const std::string &name)
+  OutputWriter<dim>::set_subfolder(const std::string &name)
   {
     subfolder.clear();
     if (!write_files)
@@ -255,40 +309,48 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  OutputWriter::write_vtu(const DoFHandler<2>             &dof_handler,
-                          const std::vector<unsigned int> &body_of_cell,
-                          const Vector<double>            &solution,
-                          const Materials                 &materials,
-                          const std::vector<ContactPair>  &pairs,
-                          const ContactSolution           &contact,
-                          const Results                   &results) const
+  OutputWriter<dim>::write_vtu(const DoFHandler<dim>           &dof_handler,
+                               const std::vector<unsigned int> &body_of_cell,
+                               const Vector<double>            &solution,
+                               const Materials<dim>            &materials,
+                               const ContactPairs<dim>         &pairs,
+                               const ContactSolution           &contact,
+                               const Results<dim>              &results) const
   {
-    DataOut<2> data_out;
+    DataOut<dim> data_out;
     data_out.attach_dof_handler(dof_handler);
     const std::vector<DataComponentInterpretation::DataComponentInterpretation>
-      vector_field(2, DataComponentInterpretation::component_is_part_of_vector);
+      vector_field(dim,
+                   DataComponentInterpretation::component_is_part_of_vector);
     data_out.add_data_vector(solution,
-                             std::vector<std::string>(2, "displacement"),
-                             DataOut<2>::type_dof_data,
+                             std::vector<std::string>(dim, "displacement"),
+                             DataOut<dim>::type_dof_data,
                              vector_field);
-    StressPostprocessor stress(materials);
+    StressPostprocessor<dim> stress(materials);
     data_out.add_data_vector(solution, stress);
 
     // Contact pressure and active flag at the slave vertices, stored in the
-    // two components of a displacement-like vector.
+    // first two components of a displacement-like vector (3D: the third is
+    // unused).
     Vector<double> contact_field(dof_handler.n_dofs());
     for (unsigned int p = 0; p < pairs.size(); ++p)
       {
-        contact_field(pairs[p].slave_dofs[0]) = results.pressure[p];
-        contact_field(pairs[p].slave_dofs[1]) = contact.active[p] ? 1 : 0;
+        contact_field(pairs.points[p].slave_dofs[0]) = results.pressure[p];
+        contact_field(pairs.points[p].slave_dofs[1]) =
+          contact.active[p] ? 1 : 0;
       }
+    std::vector<std::string> contact_names{"contact_pressure",
+                                           "contact_active"};
+    if (dim == 3)
+      contact_names.emplace_back("unused");
     data_out.add_data_vector(
       contact_field,
-      std::vector<std::string>{"contact_pressure", "contact_active"},
-      DataOut<2>::type_dof_data,
+      contact_names,
+      DataOut<dim>::type_dof_data,
       std::vector<DataComponentInterpretation::DataComponentInterpretation>(
-        2, DataComponentInterpretation::component_is_scalar));
+        dim, DataComponentInterpretation::component_is_scalar));
 
     Vector<float> material_id(body_of_cell.size()),
       body_id(body_of_cell.size());
@@ -314,68 +376,91 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  OutputWriter::write_cells(const DoFHandler<2>             &dof_handler,
-                            const std::vector<unsigned int> &body_of_cell,
-                            const Vector<double>            &solution,
-                            const Results                   &results) const
+  OutputWriter<dim>::write_cells(const DoFHandler<dim>           &dof_handler,
+                                 const std::vector<unsigned int> &body_of_cell,
+                                 const Vector<double>            &solution,
+                                 const Results<dim>              &results) const
   {
-    // Binary (NumPy's .npy, float32, one row per cell: material id, body
-    // id, then x, y, u_x, u_y, stress_yy at the four vertices
-    // counter-clockwise; a triangle repeats its third vertex): the picture
-    // script's input, smaller than the VTU and written in a fraction of the
-    // time a text file takes.
-    const unsigned int n_columns = 2 + 4 * 5;
     std::vector<float> data;
-    data.reserve(std::size_t(dof_handler.get_triangulation().n_active_cells()) *
-                 n_columns);
-    for (const auto &cell : dof_handler.active_cell_iterators())
+    unsigned int       n_columns = 0;
+    if constexpr (dim == 2)
       {
-        data.push_back(cell->material_id());
-        data.push_back(body_of_cell[cell->active_cell_index()]);
-        // Counter-clockwise: deal.II's vertex order is 0 1 3 2 on a
-        // quadrilateral, 0 1 2 on a triangle.
-        const bool triangle = cell->n_vertices() == 3;
-        for (const unsigned int v :
-             triangle ? std::array<unsigned int, 4>{{0, 1, 2, 2}}
-                      : std::array<unsigned int, 4>{{0, 1, 3, 2}})
+        // Binary (NumPy's .npy, float32, one row per cell: material id,
+        // body id, then x, y, u_x, u_y, stress_yy at the four vertices
+        // counter-clockwise; a triangle repeats its third vertex): the
+        // picture script's input, smaller than the VTU and written in a
+        // fraction of the time a text file takes.
+        n_columns = 2 + 4 * 5;
+        data.reserve(
+          std::size_t(dof_handler.get_triangulation().n_active_cells()) *
+          n_columns);
+        for (const auto &cell : dof_handler.active_cell_iterators())
           {
-            data.push_back(cell->vertex(v)[0]);
-            data.push_back(cell->vertex(v)[1]);
-            data.push_back(solution(cell->vertex_dof_index(v, 0)));
-            data.push_back(solution(cell->vertex_dof_index(v, 1)));
-            data.push_back(
-              results.vertex_stress_yy[cell->active_cell_index()][v]);
+            data.push_back(cell->material_id());
+            data.push_back(body_of_cell[cell->active_cell_index()]);
+            // Counter-clockwise: deal.II's vertex order is 0 1 3 2 on a
+            // quadrilateral, 0 1 2 on a triangle.
+            const bool triangle = cell->n_vertices() == 3;
+            for (const unsigned int v :
+                 triangle ? std::array<unsigned int, 4>{{0, 1, 2, 2}}
+                          : std::array<unsigned int, 4>{{0, 1, 3, 2}})
+              {
+                data.push_back(cell->vertex(v)[0]);
+                data.push_back(cell->vertex(v)[1]);
+                data.push_back(solution(cell->vertex_dof_index(v, 0)));
+                data.push_back(solution(cell->vertex_dof_index(v, 1)));
+                data.push_back(
+                  results.vertex_stress_yy[cell->active_cell_index()][v]);
+              }
           }
       }
-    write_checked(staging("cells.npy"),
-                  final_path("cells.npy"),
-                  [&](std::ostream &out) {
-                    std::string header =
-                      "{'descr': '<f4', 'fortran_order': False, "
-                      "'shape': (" +
-                      std::to_string(data.size() / n_columns) + ", " +
-                      std::to_string(n_columns) + "), }";
-                    // Magic, version 1.0, header length; header padded with
-                    // spaces and a newline so that the data starts at a
-                    // multiple of 64 bytes.
-                    const std::size_t total = 10 + header.size() + 1;
-                    header += std::string((64 - total % 64) % 64, ' ') + "\n";
-                    const std::uint16_t length = header.size();
-                    out.write("\x93NUMPY\x01\x00", 8);
-                    out.put(static_cast<char>(length & 0xff));
-                    out.put(static_cast<char>(length >> 8));
-                    out << header;
-                    static_assert(sizeof(float) == 4, "float32 expected");
-                    out.write(reinterpret_cast<const char *>(data.data()),
-                              data.size() * sizeof(float));
-                  });
+    else
+      {
+        // 3D: the boundary faces, one row each: material id, body id, then
+        // x, y, z, u_x, u_y, u_z and von Mises at the four vertices in a
+        // ring (a triangle repeats its third vertex); what the 3D picture
+        // draws.
+        n_columns = 2 + 4 * 7;
+        for (const auto &cell : dof_handler.active_cell_iterators())
+          for (const unsigned int f : cell->face_indices())
+            if (cell->face(f)->at_boundary())
+              {
+                data.push_back(cell->material_id());
+                data.push_back(body_of_cell[cell->active_cell_index()]);
+                const unsigned int n = cell->face(f)->n_vertices();
+                for (const unsigned int k :
+                     n == 3 ? std::array<unsigned int, 4>{{0, 1, 2, 2}}
+                            : std::array<unsigned int, 4>{{0, 1, 3, 2}})
+                  {
+                    // The face's k-th vertex as the cell numbers it, for
+                    // the cell's vertex stresses.
+                    unsigned int v = 0;
+                    for (const unsigned int c : cell->vertex_indices())
+                      if (cell->vertex_index(c) ==
+                          cell->face(f)->vertex_index(k))
+                        v = c;
+                    for (unsigned int d = 0; d < dim; ++d)
+                      data.push_back(cell->vertex(v)[d]);
+                    for (unsigned int d = 0; d < dim; ++d)
+                      data.push_back(solution(cell->vertex_dof_index(v, d)));
+                    data.push_back(
+                      results.vertex_von_mises[cell->active_cell_index()][v]);
+                  }
+              }
+      }
+    const std::string name = dim == 2 ? "cells.npy" : "surface.npy";
+    write_checked(staging(name), final_path(name), [&](std::ostream &out) {
+      write_npy(out, data, n_columns);
+    });
   }
 
 
 
+  template <int dim>
   void
-  OutputWriter::write_file(
+  OutputWriter<dim>::write_file(
     const std::string                         &name,
     const std::function<void(std::ostream &)> &write) const
   {
@@ -384,8 +469,9 @@ namespace knee_contact
 
 
 
+  template <int dim>
   bool
-  OutputWriter::run_script(const std::string &script_name,
+  OutputWriter<dim>::run_script(const std::string &script_name,
                            std::string       &message) const
   {
     if (!write_files || !pictures)
@@ -417,33 +503,36 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  OutputWriter::write_contact_csv(const ContactInterfaces        &interfaces,
-                                  const std::vector<ContactPair> &pairs,
-                                  const Vector<double>           &solution,
-                                  const ContactSolution          &contact,
-                                  const Results                  &results) const
+  OutputWriter<dim>::write_contact_csv(const ContactInterfaces &interfaces,
+                                       const ContactPairs<dim> &pairs,
+                                       const Vector<double>    &solution,
+                                       const ContactSolution   &contact,
+                                       const Results<dim>      &results) const
   {
     for (unsigned int i = 0; i < interfaces.interfaces().size(); ++i)
       {
         // Order the pairs along the interface by the coordinate it spans
         // most, and measure arc length between slave vertices.
+        // (2D: 3D has no contact rows yet.)
         std::vector<unsigned int> order;
         Point<2>                  lower(1e300, 1e300), upper(-1e300, -1e300);
         for (unsigned int p = 0; p < pairs.size(); ++p)
-          if (pairs[p].interface == i)
+          if (pairs.rows[p].interface == i)
             {
               order.push_back(p);
               for (unsigned int d = 0; d < 2; ++d)
                 {
-                  lower[d] = std::min(lower[d], pairs[p].position[d]);
-                  upper[d] = std::max(upper[d], pairs[p].position[d]);
+                  lower[d] = std::min(lower[d], pairs.points[p].position[d]);
+                  upper[d] = std::max(upper[d], pairs.points[p].position[d]);
                 }
             }
         const unsigned int axis =
           (upper[0] - lower[0] >= upper[1] - lower[1]) ? 0 : 1;
         std::sort(order.begin(), order.end(), [&](unsigned a, unsigned b) {
-          return pairs[a].position[axis] < pairs[b].position[axis];
+          return pairs.points[a].position[axis] <
+                 pairs.points[b].position[axis];
         });
         const std::string name = csv_file_name(interfaces.interfaces()[i].name);
         write_checked(staging(name), final_path(name), [&](std::ostream &out) {
@@ -455,12 +544,14 @@ namespace knee_contact
           double s = 0;
           for (unsigned int k = 0; k < order.size(); ++k)
             {
-              const ContactPair &pair = pairs[order[k]];
+              const ContactPoint<dim> &point = pairs.points[order[k]];
+              const ContactRow        &row   = pairs.rows[order[k]];
               if (k > 0)
-                s += pair.position.distance(pairs[order[k - 1]].position);
-              out << s << ',' << pair.position[0] << ',' << pair.position[1]
-                  << ',' << pair.normal[0] << ',' << pair.normal[1] << ','
-                  << pair.gap << ',' << pair.jump(solution) << ','
+                s += point.position.distance(
+                  pairs.points[order[k - 1]].position);
+              out << s << ',' << point.position[0] << ',' << point.position[1]
+                  << ',' << point.normal[0] << ',' << point.normal[1] << ','
+                  << row.gap << ',' << row.jump(solution) << ','
                   << results.pressure[order[k]] << ','
                   << (contact.active[order[k]] ? 1 : 0) << ','
                   << pairing_name(results.interfaces[i].pairing) << '\n';
@@ -471,11 +562,12 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  OutputWriter::write_summary(
-    const Results                       &results,
+  OutputWriter<dim>::write_summary(
+    const Results<dim>                  &results,
     const ContactSolution               &contact,
-    const Materials                     &materials,
+    const Materials<dim>                &materials,
     const std::map<std::string, double> &wall_times,
     const std::string                   &solver,
     const std::map<std::string, double> &solver_figures) const
@@ -486,17 +578,26 @@ namespace knee_contact
     summary["n_cells"]              = results.n_cells;
     summary["n_bodies"]             = results.n_bodies;
     summary["elements"]             = results.elements;
-    summary["applied_load"]         = {results.applied_load[0],
-                                       results.applied_load[1]};
+    const auto vector = [](const auto &v) {
+      std::vector<double> components(dim);
+      for (unsigned int d = 0; d < dim; ++d)
+        components[d] = v[d];
+      return components;
+    };
+    summary["dimension"]            = dim;
+    summary["applied_load"]         = vector(results.applied_load);
     summary["equilibrium_residual"] = results.equilibrium_residual;
     summary["energy"]               = results.energy;
     summary["max_displacement"]     = results.max_displacement;
     for (const auto &[id, reaction] : results.reactions)
-      summary["reactions"][std::to_string(id)] = {reaction[0], reaction[1]};
+      summary["reactions"][std::to_string(id)] = vector(reaction);
     for (const auto &[id, range] : results.stress_yy_range)
       summary["stress_yy"][materials[id].name] = {{"material_id", id},
                                                   {"min", range.first},
                                                   {"max", range.second}};
+    for (const auto &[id, value] : results.von_mises_max)
+      summary["von_mises_max"][materials[id].name] = {{"material_id", id},
+                                                      {"max", value}};
     unsigned int n_pairs = 0, n_active = 0;
     for (const auto &i : results.interfaces)
       {
@@ -507,7 +608,7 @@ namespace knee_contact
           {"n_pairs", i.n_pairs},
           {"n_active", i.n_active},
           {"force", i.force},
-          {"force_on_slave", {i.force_on_slave[0], i.force_on_slave[1]}},
+          {"force_on_slave", vector(i.force_on_slave)},
           {"max_pressure", i.max_pressure},
           {"contact_length", i.contact_length}};
       }
@@ -523,7 +624,7 @@ namespace knee_contact
     summary["complementarity_residual"]  = contact.complementarity;
     summary["deformation_magnification"] = magnification;
     for (const auto &[name, point] : labels)
-      summary["labels"][name] = {point[0], point[1]};
+      summary["labels"][name] = vector(point);
     if (!contact.converged)
       summary["failure"] = contact.failure;
     if (!warnings.empty())
@@ -537,4 +638,8 @@ namespace knee_contact
                   final_path("summary.json"),
                   [&](std::ostream &out) { out << summary.dump(2) << '\n'; });
   }
+
+
+  template class OutputWriter<2>;
+  template class OutputWriter<3>;
 } // namespace knee_contact

@@ -75,15 +75,16 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  Refinement::refine(const Strategy                  strategy,
-                     Triangulation<2>               &triangulation,
-                     const DoFHandler<2>            &dof_handler,
-                     const Vector<double>           &solution,
-                     const Materials                &materials,
-                     const ContactInterfaces        &interfaces,
-                     const std::vector<ContactPair> &pairs,
-                     const ContactSolution          &contact) const
+  Refinement::refine(const Strategy           strategy,
+                     Triangulation<dim>      &triangulation,
+                     const DoFHandler<dim>   &dof_handler,
+                     const Vector<double>    &solution,
+                     const Materials<dim>    &materials,
+                     const ContactInterfaces &interfaces,
+                     const ContactPairs<dim> &pairs,
+                     const ContactSolution   &contact) const
   {
     if (strategy == Strategy::global)
       {
@@ -91,9 +92,10 @@ namespace knee_contact
         return;
       }
     Vector<float> kelly(triangulation.n_active_cells());
-    KellyErrorEstimator<2>::estimate(elements::mapping(dof_handler),
-                                     dof_handler,
-                                     QGauss<1>(2),
+    KellyErrorEstimator<dim>::estimate(elements::mapping(dof_handler),
+                                       dof_handler,
+                                       elements::face_quadrature(dof_handler,
+                                                                 2),
                                      {},
                                      solution,
                                      kelly);
@@ -108,17 +110,22 @@ namespace knee_contact
       {
         // The contact zone: within one slave spacing of an active pair, on
         // either side.
-        std::vector<std::pair<Point<2>, double>> zone;
+        std::vector<std::pair<Point<dim>, double>> zone;
         for (unsigned int p = 0; p < pairs.size(); ++p)
           if (contact.active[p])
-            zone.emplace_back(pairs[p].position, 2 * pairs[p].length);
+            zone.emplace_back(pairs.points[p].position,
+                              2 * std::pow(pairs.rows[p].length,
+                                           1. / (dim - 1)));
         for (const auto &cell : triangulation.active_cell_iterators())
           for (const unsigned int v : cell->vertex_indices())
             for (const auto &[centre, radius] : zone)
               if (cell->vertex(v).distance(centre) <= radius)
                 cell->set_refine_flag();
       }
-    mark_partners(triangulation, interfaces);
+    if constexpr (dim == 2)
+      mark_partners(triangulation, interfaces);
+    else
+      Assert(interfaces.interfaces().empty(), ExcNotImplemented());
     triangulation.execute_coarsening_and_refinement();
   }
 
@@ -204,4 +211,24 @@ namespace knee_contact
            : strategy == Strategy::adaptive ? "adaptive"
                                             : "compare";
   }
+
+
+  template void
+  Refinement::refine(const Strategy,
+                     Triangulation<2> &,
+                     const DoFHandler<2> &,
+                     const Vector<double> &,
+                     const Materials<2> &,
+                     const ContactInterfaces &,
+                     const ContactPairs<2> &,
+                     const ContactSolution &) const;
+  template void
+  Refinement::refine(const Strategy,
+                     Triangulation<3> &,
+                     const DoFHandler<3> &,
+                     const Vector<double> &,
+                     const Materials<3> &,
+                     const ContactInterfaces &,
+                     const ContactPairs<3> &,
+                     const ContactSolution &) const;
 } // namespace knee_contact

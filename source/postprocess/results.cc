@@ -14,19 +14,20 @@
 
 namespace knee_contact
 {
-  Results
-  compute_results(const DoFHandler<2>             &dof_handler,
+  template <int dim>
+  Results<dim>
+  compute_results(const DoFHandler<dim>           &dof_handler,
                   const std::vector<unsigned int> &body_of_cell,
                   const SparseMatrix<double>      &matrix,
                   const Vector<double>            &rhs,
                   const Vector<double>            &solution,
-                  const Materials                 &materials,
-                  const BoundaryConditions        &boundary_conditions,
+                  const Materials<dim>            &materials,
+                  const BoundaryConditions<dim>   &boundary_conditions,
                   const ContactInterfaces         &interfaces,
-                  const std::vector<ContactPair>  &pairs,
+                  const ContactPairs<dim>         &pairs,
                   const ContactSolution           &contact)
   {
-    Results results;
+    Results<dim> results;
     results.n_dofs   = dof_handler.n_dofs();
     results.n_cells  = dof_handler.get_triangulation().n_active_cells();
     results.elements = elements::name(dof_handler.get_fe().reference_cell());
@@ -42,7 +43,7 @@ namespace knee_contact
     matrix.vmult(support_force, solution);
     support_force -= rhs;
     for (unsigned int p = 0; p < pairs.size(); ++p)
-      for (const auto &[dof, a] : pairs[p].row)
+      for (const auto &[dof, a] : pairs.rows[p].row)
         support_force(dof) += a * contact.lambda[p];
     // A hanging node's force belongs to the vertices it hangs from:
     // apply the transpose of its constraint.
@@ -73,7 +74,7 @@ namespace knee_contact
     std::vector<bool> counted(dof_handler.n_dofs(), false);
     for (const auto &cell : dof_handler.active_cell_iterators())
       for (const unsigned int v : cell->vertex_indices())
-        for (unsigned int d = 0; d < 2; ++d)
+        for (unsigned int d = 0; d < dim; ++d)
           {
             const auto dof = cell->vertex_dof_index(v, d);
             if (!counted[dof])
@@ -91,8 +92,8 @@ namespace knee_contact
             for (const auto &face : cell->face_iterators())
               if (face->at_boundary() &&
                   condition.ids.count(face->boundary_id()))
-                for (unsigned int v = 0; v < 2; ++v)
-                  for (unsigned int d = 0; d < 2; ++d)
+                for (const unsigned int v : face->vertex_indices())
+                  for (unsigned int d = 0; d < dim; ++d)
                     {
                       const auto dof = face->vertex_dof_index(v, d);
                       if (!counted[dof] && (sliding || condition.mask[d]))
@@ -105,7 +106,7 @@ namespace knee_contact
     // The force scale: the load, the reactions, or for a scene driven by
     // prescribed displacements the force E max|u| that straining a body of
     // unit size by max|u| takes.
-    Tensor<1, 2> balance = results.applied_load;
+    Tensor<1, dim> balance = results.applied_load;
     double       scale =
       std::max(results.applied_load.norm(),
                materials.max_youngs_modulus() * results.max_displacement);
@@ -116,34 +117,41 @@ namespace knee_contact
       }
     results.equilibrium_residual = scale > 0 ? balance.norm() / scale : 0;
 
-    // tau_yy at the vertices of every cell, as the pictures show it.
-    // (Q1: the trapezoidal rule's points are the vertices in deal.II's
-    // order; P1: the triangle's vertices. A triangle repeats its third
-    // vertex in the fourth entry, as cells.npy does.)
+    // tau_yy and von Mises at the vertices of every cell, as the pictures
+    // show them. (Q1: the trapezoidal rule's points are the vertices in
+    // deal.II's order; P1: the simplex's vertices. A simplex repeats its
+    // last vertex in the remaining entries, as cells.npy does.)
     const ReferenceCell kind = dof_handler.get_fe().reference_cell();
-    FEValues<2>         fe_values(elements::mapping(dof_handler),
-                          dof_handler.get_fe(),
-                          kind.get_nodal_type_quadrature<2>(),
-                          update_gradients);
+    FEValues<dim>       fe_values(elements::mapping(dof_handler),
+                            dof_handler.get_fe(),
+                            kind.template get_nodal_type_quadrature<dim>(),
+                            update_gradients);
     const unsigned int  n_vertices = kind.n_vertices();
-    std::vector<SymmetricTensor<2, 2>> strains(n_vertices);
-    const FEValuesExtractors::Vector   displacement(0);
+    std::vector<SymmetricTensor<2, dim>> strains(n_vertices);
+    const FEValuesExtractors::Vector     displacement(0);
     results.vertex_stress_yy.resize(results.n_cells);
+    results.vertex_von_mises.resize(results.n_cells);
     for (const auto &cell : dof_handler.active_cell_iterators())
       {
         fe_values.reinit(cell);
         fe_values[displacement].get_function_symmetric_gradients(solution,
                                                                  strains);
-        const Material &material = materials[cell->material_id()];
+        const Material<dim> &material = materials[cell->material_id()];
         auto            range    = results.stress_yy_range.emplace(
           cell->material_id(),
           std::make_pair(std::numeric_limits<double>::max(),
                          -std::numeric_limits<double>::max()));
-        for (unsigned int v = 0; v < 4; ++v)
+        double &von_mises_max = results.von_mises_max[cell->material_id()];
+        for (unsigned int v = 0; v < GeometryInfo<dim>::vertices_per_cell;
+             ++v)
           {
-            const double syy =
-              material.stress(strains[std::min(v, n_vertices - 1)])[1][1];
+            const SymmetricTensor<2, dim> stress =
+              material.stress(strains[std::min(v, n_vertices - 1)]);
+            const double syy = stress[1][1];
             results.vertex_stress_yy[cell->active_cell_index()][v] = syy;
+            const double von_mises = material.von_mises(stress);
+            results.vertex_von_mises[cell->active_cell_index()][v] = von_mises;
+            von_mises_max = std::max(von_mises_max, von_mises);
             range.first->second.first =
               std::min(range.first->second.first, syy);
             range.first->second.second =
@@ -160,18 +168,42 @@ namespace knee_contact
     results.pressure.resize(pairs.size());
     for (unsigned int p = 0; p < pairs.size(); ++p)
       {
-        InterfaceResult &r  = results.interfaces[pairs[p].interface];
-        results.pressure[p] = contact.lambda[p] / pairs[p].length;
+        InterfaceResult<dim> &r = results.interfaces[pairs.rows[p].interface];
+        results.pressure[p]     = contact.lambda[p] / pairs.rows[p].length;
         ++r.n_pairs;
         r.force += contact.lambda[p];
-        r.force_on_slave -= contact.lambda[p] * pairs[p].normal;
+        r.force_on_slave -= contact.lambda[p] * pairs.points[p].normal;
         if (contact.active[p])
           {
             ++r.n_active;
-            r.contact_length += pairs[p].length;
+            r.contact_length += pairs.rows[p].length;
             r.max_pressure = std::max(r.max_pressure, results.pressure[p]);
           }
       }
     return results;
   }
+
+
+  template Results<2>
+  compute_results(const DoFHandler<2> &,
+                  const std::vector<unsigned int> &,
+                  const SparseMatrix<double> &,
+                  const Vector<double> &,
+                  const Vector<double> &,
+                  const Materials<2> &,
+                  const BoundaryConditions<2> &,
+                  const ContactInterfaces &,
+                  const ContactPairs<2> &,
+                  const ContactSolution &);
+  template Results<3>
+  compute_results(const DoFHandler<3> &,
+                  const std::vector<unsigned int> &,
+                  const SparseMatrix<double> &,
+                  const Vector<double> &,
+                  const Vector<double> &,
+                  const Materials<3> &,
+                  const BoundaryConditions<3> &,
+                  const ContactInterfaces &,
+                  const ContactPairs<3> &,
+                  const ContactSolution &);
 } // namespace knee_contact

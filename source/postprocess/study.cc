@@ -24,6 +24,7 @@ namespace knee_contact
 
   void
   print_convergence_table(const std::vector<CycleRecord> &records,
+                          const unsigned int              dimension,
                           const bool                      with_times,
                           std::ostream                   &out)
   {
@@ -56,7 +57,10 @@ namespace knee_contact
       for (const auto &[name, error] : error_columns)
         if (!std::isnan(records.front().errors.*error))
           table.evaluate_convergence_rates(
-            name, "dofs", dealii::ConvergenceTable::reduction_rate_log2, 2);
+            name,
+            "dofs",
+            dealii::ConvergenceTable::reduction_rate_log2,
+            dimension);
     out << records.front().strategy << " refinement:" << std::endl;
     table.write_text(out);
   }

@@ -12,19 +12,22 @@
 
 namespace knee_contact
 {
+  template <int dim>
   void
-  Verification::declare_parameters(ParameterHandler &prm)
+  Verification<dim>::declare_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Verification");
     prm.declare_entry("Exact displacement",
                       "",
                       Patterns::Anything(),
-                      "Reference u = (u_x; u_y) [m] in x, y: L2, energy and "
-                      "nodal errors are reported. Empty: none.");
+                      "Reference u = (u_x; u_y) [m] in x, y (3D: (u_x; u_y; "
+                      "u_z) in x, y, z): L2, energy and nodal errors are "
+                      "reported. Empty: none.");
     prm.declare_entry("Exact stress",
                       "",
                       Patterns::Anything(),
-                      "Reference (tau_xx; tau_yy; tau_xy) [Pa]: the maximum "
+                      "Reference (tau_xx; tau_yy; tau_xy) [Pa] (3D: (tau_xx; "
+                      "tau_yy; tau_zz; tau_xy; tau_xz; tau_yz)): the maximum "
                       "error at the cells' Gauss points relative to the "
                       "largest reference stress is checked against "
                       "Tolerance. Empty: none.");
@@ -124,8 +127,9 @@ namespace knee_contact
 
 
 
+  template <int dim>
   void
-  Verification::parse_parameters(ParameterHandler &prm)
+  Verification<dim>::parse_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Verification");
     const auto optional = [&prm](const std::string &name,
@@ -133,11 +137,11 @@ namespace knee_contact
       const std::string text = prm.get(name);
       return text.empty()
                ? nullptr
-               : input::parse_expression(
+               : input::parse_expression<dim>(
                    text, n_components, "Verification/" + name, "", true);
     };
-    exact_displacement = optional("Exact displacement", 2);
-    exact_stress       = optional("Exact stress", 3);
+    exact_displacement = optional("Exact displacement", dim);
+    exact_stress       = optional("Exact stress", dim == 2 ? 3 : 6);
     exact_pressure     = optional("Exact contact pressure", 1);
     tolerance          = prm.get_double("Tolerance");
     min_l2_rate        = prm.get_double("Minimum L2 rate");
@@ -188,12 +192,13 @@ namespace knee_contact
 
 
 
+  template <int dim>
   Errors
-  Verification::compute_errors(const DoFHandler<2>            &dof_handler,
-                               const Vector<double>           &solution,
-                               const Materials                &materials,
-                               const std::vector<ContactPair> &pairs,
-                               const Results                  &results) const
+  Verification<dim>::compute_errors(const DoFHandler<dim>   &dof_handler,
+                                    const Vector<double>    &solution,
+                                    const Materials<dim>    &materials,
+                                    const ContactPairs<dim> &pairs,
+                                    const Results<dim>      &results) const
   {
     Errors errors;
     if (exact_displacement || exact_stress)
@@ -201,19 +206,26 @@ namespace knee_contact
         // Errors in L2, in the energy norm a(e, e)^1/2 and of the stress at
         // Gauss points; the exact gradient comes from fourth order
         // differences of the expression.
-        FEValues<2> fe_values(elements::mapping(dof_handler),
+        FEValues<dim> fe_values(elements::mapping(dof_handler),
                               dof_handler.get_fe(),
                               elements::cell_quadrature(dof_handler, 3),
                               update_values | update_gradients |
                                 update_quadrature_points | update_JxW_values);
         const FEValuesExtractors::Vector   u(0);
         const unsigned int                 n_q = fe_values.n_quadrature_points;
-        std::vector<Tensor<1, 2>>          values(n_q);
-        std::vector<SymmetricTensor<2, 2>> strains(n_q);
-        std::vector<Vector<double>>        exact_values(n_q, Vector<double>(2));
-        std::vector<std::vector<Tensor<1, 2>>> exact_gradients(
-          n_q, std::vector<Tensor<1, 2>>(2));
-        Vector<double> stress_values(3);
+        std::vector<Tensor<1, dim>>          values(n_q);
+        std::vector<SymmetricTensor<2, dim>> strains(n_q);
+        std::vector<Vector<double>> exact_values(n_q, Vector<double>(dim));
+        std::vector<std::vector<Tensor<1, dim>>> exact_gradients(
+          n_q, std::vector<Tensor<1, dim>>(dim));
+        // The components of Exact stress, in its order.
+        const std::vector<std::pair<unsigned int, unsigned int>> components =
+          dim == 2 ? std::vector<std::pair<unsigned int, unsigned int>>{{0, 0},
+                                                                        {1, 1},
+                                                                        {0, 1}}
+                   : std::vector<std::pair<unsigned int, unsigned int>>{
+                       {0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
+        Vector<double> stress_values(components.size());
         double         l2 = 0, l2_norm = 0, energy = 0, energy_norm = 0;
         double         stress_error = 0, stress_max = 0;
         for (const auto &cell : dof_handler.active_cell_iterators())
@@ -221,7 +233,7 @@ namespace knee_contact
             fe_values.reinit(cell);
             fe_values[u].get_function_values(solution, values);
             fe_values[u].get_function_symmetric_gradients(solution, strains);
-            const Material &material = materials[cell->material_id()];
+            const Material<dim> &material = materials[cell->material_id()];
             if (exact_displacement)
               {
                 exact_displacement->vector_value_list(
@@ -233,15 +245,15 @@ namespace knee_contact
               {
                 if (exact_displacement)
                   {
-                    SymmetricTensor<2, 2> exact_strain;
-                    for (unsigned int i = 0; i < 2; ++i)
-                      for (unsigned int j = i; j < 2; ++j)
+                    SymmetricTensor<2, dim> exact_strain;
+                    for (unsigned int i = 0; i < dim; ++i)
+                      for (unsigned int j = i; j < dim; ++j)
                         exact_strain[i][j] = 0.5 * (exact_gradients[q][i][j] +
                                                     exact_gradients[q][j][i]);
-                    Tensor<1, 2> exact;
-                    exact[0]                      = exact_values[q](0);
-                    exact[1]                      = exact_values[q](1);
-                    const SymmetricTensor<2, 2> e = strains[q] - exact_strain;
+                    Tensor<1, dim> exact;
+                    for (unsigned int d = 0; d < dim; ++d)
+                      exact[d] = exact_values[q](d);
+                    const SymmetricTensor<2, dim> e = strains[q] - exact_strain;
                     l2 += (values[q] - exact).norm_square() * fe_values.JxW(q);
                     l2_norm += exact.norm_square() * fe_values.JxW(q);
                     energy += material.stress(e) * e * fe_values.JxW(q);
@@ -253,15 +265,15 @@ namespace knee_contact
                     exact_stress->vector_value(fe_values.quadrature_point(q),
                                                stress_values);
                     const auto s = material.stress(strains[q]);
-                    stress_error =
-                      std::max({stress_error,
-                                std::abs(s[0][0] - stress_values(0)),
-                                std::abs(s[1][1] - stress_values(1)),
-                                std::abs(s[0][1] - stress_values(2))});
-                    stress_max = std::max({stress_max,
-                                           std::abs(stress_values(0)),
-                                           std::abs(stress_values(1)),
-                                           std::abs(stress_values(2))});
+                    for (unsigned int c = 0; c < components.size(); ++c)
+                      {
+                        const auto [i, j] = components[c];
+                        stress_error      = std::max(stress_error,
+                                                std::abs(s[i][j] -
+                                                         stress_values(c)));
+                        stress_max =
+                          std::max(stress_max, std::abs(stress_values(c)));
+                      }
                   }
               }
           }
@@ -274,15 +286,15 @@ namespace knee_contact
             // reference that jumps between bodies in contact is taken from
             // the vertex's own body.
             double         nodal = 0, largest = 0;
-            Vector<double> exact(2);
+            Vector<double> exact(dim);
             for (const auto &cell : dof_handler.active_cell_iterators())
               for (const unsigned int v : cell->vertex_indices())
                 {
-                  const Point<2> inside =
+                  const Point<dim> inside =
                     cell->vertex(v) +
                     1e-12 * (cell->center() - cell->vertex(v));
                   exact_displacement->vector_value(inside, exact);
-                  for (unsigned int d = 0; d < 2; ++d)
+                  for (unsigned int d = 0; d < dim; ++d)
                     {
                       nodal =
                         std::max(nodal,
@@ -303,7 +315,8 @@ namespace knee_contact
         double error = 0, largest = 0;
         for (unsigned int p = 0; p < pairs.size(); ++p)
           {
-            const double exact = exact_pressure->value(pairs[p].position);
+            const double exact =
+              exact_pressure->value(pairs.points[p].position);
             error   = std::max(error, std::abs(results.pressure[p] - exact));
             largest = std::max(largest, std::abs(exact));
           }
@@ -311,9 +324,11 @@ namespace knee_contact
         double l2 = 0, norm = 0;
         for (unsigned int p = 0; p < pairs.size(); ++p)
           {
-            const double exact = exact_pressure->value(pairs[p].position);
-            l2 += pairs[p].length * std::pow(results.pressure[p] - exact, 2);
-            norm += pairs[p].length * exact * exact;
+            const double exact =
+              exact_pressure->value(pairs.points[p].position);
+            const double weight = pairs.rows[p].length;
+            l2 += weight * std::pow(results.pressure[p] - exact, 2);
+            norm += weight * exact * exact;
           }
         errors.pressure_l2_relative = std::sqrt(l2 / norm);
       }
@@ -352,8 +367,9 @@ namespace knee_contact
 
 
 
+  template <int dim>
   unsigned int
-  Verification::check_study(const std::vector<Errors> &uniform_errors,
+  Verification<dim>::check_study(const std::vector<Errors> &uniform_errors,
                             const std::vector<double> &uniform_dofs,
                             const std::vector<Errors> &adaptive_errors,
                             const std::vector<double> &adaptive_dofs,
@@ -388,8 +404,9 @@ namespace knee_contact
 
 
 
+  template <int dim>
   unsigned int
-  Verification::check(const Results             &results,
+  Verification<dim>::check(const Results<dim>        &results,
                       const ContactSolution     &contact,
                       const bool                 has_contact,
                       const std::vector<Errors> &errors,
@@ -423,13 +440,13 @@ namespace knee_contact
              "<=",
              tolerance);
 
-    // Observed rates between successive cycles, h ~ n_dofs^(-1/2).
+    // Observed rates between successive cycles, h ~ n_dofs^(-1/dim).
     const auto min_rate = [&](double Errors::*error) {
       double rate = std::numeric_limits<double>::max();
       for (unsigned int k = 2; k < errors.size(); ++k)
         rate = std::min(rate,
                         std::log(errors[k - 1].*error / errors[k].*error) /
-                          (0.5 * std::log(n_dofs[k] / n_dofs[k - 1])));
+                          (std::log(n_dofs[k] / n_dofs[k - 1]) / dim));
       return rate;
     };
     if (min_l2_rate > 0)
@@ -503,7 +520,7 @@ namespace knee_contact
       {
         const auto it = std::find_if(results.interfaces.begin(),
                                      results.interfaces.end(),
-                                     [&](const InterfaceResult &i) {
+                                     [&](const InterfaceResult<dim> &i) {
                                        return i.name == name;
                                      });
         AssertThrow(it != results.interfaces.end(),
@@ -519,12 +536,17 @@ namespace knee_contact
   }
 
 
+  template <int dim>
   void
-  Verification::set_load_parameter(const double t)
+  Verification<dim>::set_load_parameter(const double t)
   {
     for (auto *function :
          {exact_displacement.get(), exact_stress.get(), exact_pressure.get()})
       if (function != nullptr)
         function->set_time(t);
   }
+
+
+  template class Verification<2>;
+  template class Verification<3>;
 } // namespace knee_contact

@@ -98,7 +98,7 @@ namespace knee_contact
 
   void
   ActiveSetSolver::make_constraints(const AffineConstraints<double> &base,
-                                    const std::vector<ContactPair>  &pairs,
+                                    const std::vector<ContactRow>  &pairs,
                                     const std::vector<bool>         &active,
                                     AffineConstraints<double> &constraints)
   {
@@ -108,7 +108,7 @@ namespace knee_contact
     for (unsigned int p = 0; p < pairs.size(); ++p)
       if (active[p])
         {
-          const ContactPair &pair = pairs[p];
+          const ContactRow &pair = pairs[p];
           double             a_j  = 0;
           for (const auto &[dof, a] : pair.reduced_row)
             if (dof == pair.eliminated)
@@ -130,7 +130,7 @@ namespace knee_contact
   std::vector<double>
   ActiveSetSolver::multipliers(const Vector<double>            &residual,
                                const AffineConstraints<double> &base,
-                               const std::vector<ContactPair>  &pairs,
+                               const std::vector<ContactRow>  &pairs,
                                const std::vector<bool>         &active)
   {
     // Equations at the eliminated dofs j_p of the active pairs:
@@ -194,9 +194,9 @@ namespace knee_contact
 
 
   void
-  ActiveSetSolver::make_sparsity_pattern(const DoFHandler<2> &dof_handler,
+  ActiveSetSolver::make_sparsity_pattern(const DynamicSparsityPattern &mesh_pattern,
                                          const AffineConstraints<double> &base,
-                                         const std::vector<ContactPair>  &pairs,
+                                         const std::vector<ContactRow>  &pairs,
                                          SparsityPattern &sparsity_pattern)
   {
     // One sparsity pattern serves every active set. Condensing a set of
@@ -247,10 +247,8 @@ namespace knee_contact
     for (const auto &entry : one_level)
       closure(entry.first);
 
-    DynamicSparsityPattern mesh_pattern(dof_handler.n_dofs());
-    DoFTools::make_sparsity_pattern(dof_handler, mesh_pattern);
-    DynamicSparsityPattern dsp(dof_handler.n_dofs());
-    for (types::global_dof_index i = 0; i < dof_handler.n_dofs(); ++i)
+    DynamicSparsityPattern dsp(mesh_pattern.n_rows());
+    for (types::global_dof_index i = 0; i < mesh_pattern.n_rows(); ++i)
       {
         const auto ei = expansion.find(i);
         for (auto it = mesh_pattern.begin(i); it != mesh_pattern.end(i); ++it)
@@ -276,7 +274,7 @@ namespace knee_contact
 
   FullContactSystem::FullContactSystem(const SparseMatrix<double>      &matrix,
                                        const AffineConstraints<double> &base,
-                                       const std::vector<ContactPair>  &pairs)
+                                       const std::vector<ContactRow>  &pairs)
     : matrix(matrix)
     , base(base)
     , pairs(pairs)
@@ -330,7 +328,7 @@ namespace knee_contact
                                           const Vector<double>       &rhs,
                                           const Vector<double>       &x,
                                           const AffineConstraints<double> &base,
-                                          const std::vector<ContactPair> &pairs,
+                                          const std::vector<ContactRow> &pairs,
                                           const std::vector<bool> &active,
                                           std::vector<double>     &excess,
                                           std::vector<double>     &lambda)
@@ -346,7 +344,7 @@ namespace knee_contact
 
 
   double
-  ActiveSetSolver::displacement_scale(const std::vector<ContactPair> &pairs,
+  ActiveSetSolver::displacement_scale(const std::vector<ContactRow> &pairs,
                                       const Vector<double>           &x)
   {
     // Over the contact unknowns, as the condensed path sees them.
@@ -372,8 +370,8 @@ namespace knee_contact
   ActiveSetSolver::solve(ContactSystem                   &system,
                          const double                     force_scale_of_load,
                          const AffineConstraints<double> &base,
-                         const std::vector<ContactPair>  &pairs,
-                         const RigidModes                &rigid_modes,
+                         const std::vector<ContactRow>  &pairs,
+                         const RigidModeCheck                &rigid_modes,
                          const std::vector<bool>         &guess,
                          std::ostream                    &log) const
   {

@@ -1,6 +1,8 @@
 #ifndef knee_contact_contact_h
 #define knee_contact_contact_h
 
+#include <knee_contact/solver/contact_row.h>
+
 #include <deal.II/base/parameter_handler.h>
 #include <deal.II/base/point.h>
 
@@ -8,6 +10,7 @@
 
 #include <deal.II/dofs/dof_handler.h>
 
+#include <array>
 #include <string>
 #include <utility>
 #include <vector>
@@ -17,45 +20,52 @@ namespace knee_contact
   using namespace dealii;
 
   /**
-   * One contact pair of the seed's Gamma_c: a vertex x_p of the slave side
-   * and the point y_p where the slave's outward normal n_p meets the master
-   * side. It is one row of the seed's constraint A x <= 0 (its eq. (13)),
-   * here with the initial gap:
+   * Where a contact row sits: the slave vertex x_p and the unit normal n_p
+   * of its row a_p x <= g_p (ContactRow), for output and refinement; the
+   * solver never sees it. Node-to-segment rows read
    *   n_p . (u^k(x_p) - u^l(y_p)) <= g_p,   g_p = n_p . (y_p - x_p),
-   * where u^l(y_p) interpolates the master face linearly. Matching meshes
-   * give y_p at a master vertex: the seed's node pairs.
+   * with y_p where n_p meets the master side (matching meshes: a master
+   * vertex, the seed's node pairs); mortar rows weigh the master side's
+   * displacement over the slave vertex's support instead.
    */
-  struct ContactPair
+  template <int dim>
+  struct ContactPoint
   {
-    unsigned int interface = 0;
-    Point<2>     position;
-    Point<2>     master_point;
-    Tensor<1, 2> normal;
-    double       gap = 0;
-    /** The slave vertex's share of the slave boundary length [m]. */
-    double length = 0;
-    /** Dof indices of the slave vertex (x, y). */
-    std::array<types::global_dof_index, 2> slave_dofs;
+    Point<dim>     position;
+    Tensor<1, dim> normal;
+    /** Dof indices of the slave vertex (x, y[, z]). */
+    std::array<types::global_dof_index, dim> slave_dofs;
+  };
 
-    /** The row a_p: (dof, coefficient). */
-    std::vector<std::pair<types::global_dof_index, double>> row;
-    /**
-     * The row with the Gamma_u and Gamma_o constraints substituted, over
-     * dofs those leave free, and its right hand side.
-     */
-    std::vector<std::pair<types::global_dof_index, double>> reduced_row;
-    double                                                  reduced_gap = 0;
-    /**
-     * The dof an active pair eliminates (a free slave component if there is
-     * one, else a free master component); invalid if the row has no free
-     * dof left, i.e. Gamma_u or Gamma_o already decide it.
-     */
-    types::global_dof_index eliminated       = numbers::invalid_dof_index;
-    bool                    slave_eliminated = true;
 
-    /** a_p . x */
-    double
-    jump(const Vector<double> &x) const;
+
+  /**
+   * The contact rows of a mesh and, index by index, their points.
+   */
+  template <int dim>
+  struct ContactPairs
+  {
+    std::vector<ContactRow>        rows;
+    std::vector<ContactPoint<dim>> points;
+
+    std::size_t
+    size() const
+    {
+      return rows.size();
+    }
+
+    bool
+    empty() const
+    {
+      return rows.empty();
+    }
+
+    void
+    push_back(ContactRow &&row, const ContactPoint<dim> &point)
+    {
+      rows.push_back(std::move(row));
+      points.push_back(point);
+    }
   };
 
 
@@ -114,17 +124,19 @@ namespace knee_contact
      * Throw if a side's boundary id is missing, or both sides of an
      * interface lie on the same body.
      */
+    template <int dim>
     void
-    check_mesh(const Triangulation<2>          &triangulation,
+    check_mesh(const Triangulation<dim>        &triangulation,
                const std::vector<unsigned int> &body_ids) const;
 
     /**
-     * Pair every slave vertex of every interface (see ContactPair), and
-     * choose each pair's eliminated dof given the Gamma_u/Gamma_o
-     * @p constraints (closed).
+     * Pair every slave vertex of every interface (see ContactPoint), and
+     * choose each row's eliminated dof given the Gamma_u/Gamma_o
+     * @p constraints (closed). 2D only so far (see the specialisations).
      */
-    std::vector<ContactPair>
-    make_pairs(const DoFHandler<2>             &dof_handler,
+    template <int dim>
+    ContactPairs<dim>
+    make_pairs(const DoFHandler<dim>           &dof_handler,
                const AffineConstraints<double> &constraints) const;
 
     const std::vector<ContactInterface> &
@@ -136,6 +148,30 @@ namespace knee_contact
   private:
     std::vector<ContactInterface> list;
   };
+
+  /**
+   * The rows of the 2D discretisations (contact_sides.h): segments of the
+   * boundary curves.
+   */
+  template <>
+  ContactPairs<2>
+  ContactInterfaces::make_pairs<2>(
+    const DoFHandler<2>             &dof_handler,
+    const AffineConstraints<double> &constraints) const;
+
+  /**
+   * 3D contact needs what 2D does with segments on faces: averaged vertex
+   * normals of surface meshes, the projection of a slave vertex onto master
+   * triangles and quadrilaterals (node-to-segment), and for mortar the
+   * clipping of slave and master face polygons on an auxiliary plane
+   * (Puso-Laursen; 4C's Coupling3d, Kratos' ExactMortarIntegrationUtility).
+   * Until it exists a 3D scene with interfaces is refused.
+   */
+  template <>
+  ContactPairs<3>
+  ContactInterfaces::make_pairs<3>(
+    const DoFHandler<3>             &dof_handler,
+    const AffineConstraints<double> &constraints) const;
 } // namespace knee_contact
 
 #endif

@@ -16,8 +16,8 @@ namespace knee_contact
   using namespace dealii;
 
   /**
-   * The two sides of one contact interface as the contact discretisations
-   * see them: the slave vertices with their averaged normals, the slave
+   * The two sides of one 2D contact interface as the contact
+   * discretisations see them: the slave vertices with their averaged normals, the slave
    * faces, and the master faces. Collected once by
    * ContactInterfaces::make_pairs(); each discretisation (node-to-segment,
    * mortar) turns them into rows a_p x <= g_p, one per slave vertex.
@@ -64,7 +64,7 @@ namespace knee_contact
    * the closest facing master face (the seed's node pairs when the meshes
    * match). Rows are not yet reduced by the constraints.
    */
-  std::vector<ContactPair>
+  ContactPairs<2>
   node_to_segment_rows(const ContactSides     &sides,
                        const ContactInterface &interface,
                        const unsigned int      interface_index,
@@ -75,10 +75,10 @@ namespace knee_contact
    * multiplier basis on the slave side), one per slave vertex, normalised
    * so that they read like node-to-segment rows: the slave vertex's own
    * normal displacement minus a weighted mean of the master's, against the
-   * weighted gap; ContactPair::length is the row's weight, so multiplier /
+   * weighted gap; ContactRow::length is the row's weight, so multiplier /
    * length is the multiplier's value there, a pressure [Pa].
    */
-  std::vector<ContactPair>
+  ContactPairs<2>
   mortar_rows(const ContactSides     &sides,
               const ContactInterface &interface,
               const unsigned int      interface_index,

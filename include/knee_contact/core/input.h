@@ -30,14 +30,15 @@ namespace knee_contact
 
     /**
      * Parse @p expression with @p n_components components (separated by ';')
-     * in the variables x, y and the constants "pi" and @p constants
+     * in the variables x, y (and z in 3D) and the constants "pi" and @p constants
      * ("name=value, ..."). Throws an ExcMessage that names @p parameter if the
      * expression does not parse. A @p load expression (traction, pressure,
      * body force, exact solutions) may also use t, the load parameter of the
      * scene's load cases (FunctionParser's time, set by set_time()); elsewhere
      * t is an unknown name and the message says where it is allowed.
      */
-    std::unique_ptr<FunctionParser<2>>
+    template <int dim>
+    std::unique_ptr<FunctionParser<dim>>
     parse_expression(const std::string &expression,
                      const unsigned int n_components,
                      const std::string &parameter,
@@ -68,9 +69,11 @@ namespace knee_contact
                 const std::string &form);
 
     /**
-     * A point from "x, y", or an error naming @p parameter.
+     * A point from "x, y" (2D) or "x, y, z" (3D), or an error naming
+     * @p parameter.
      */
-    Point<2>
+    template <int dim>
+    Point<dim>
     to_point(const std::string &text, const std::string &parameter);
 
     /**

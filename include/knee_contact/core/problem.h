@@ -52,12 +52,23 @@ namespace knee_contact
 
 
   /**
+   * The dimension a scene is solved in: 3 if its mesh file has volume cells,
+   * else 2 (see the mesh's scene_dimension()).
+   */
+  unsigned int
+  scene_dimension(const std::string &scene_file);
+
+
+
+  /**
    * The contact problem of the seed: s linear elastic bodies with
    * Gamma_u, Gamma_tau, Gamma_o and unilateral contact on Gamma_c, solved
-   * on one or more meshes. It orchestrates: scene -> dofs and constraints
+   * on one or more meshes, in 2D or 3D (the dimension of the mesh:
+   * scene_dimension()). It orchestrates: scene -> dofs and constraints
    * -> assembled system -> active-set loop -> results -> files. Each step
    * is done by the class of its concept.
    */
+  template <int dim>
   class ContactProblem
   {
   public:
@@ -102,12 +113,12 @@ namespace knee_contact
     {
       return active_set_solver;
     }
-    const Materials &
+    const Materials<dim> &
     materials_of() const
     {
       return materials;
     }
-    const DoFHandler<2> &
+    const DoFHandler<dim> &
     dof_handler_of() const
     {
       return dof_handler;
@@ -127,7 +138,7 @@ namespace knee_contact
     {
       return constraints;
     }
-    const std::vector<ContactPair> &
+    const ContactPairs<dim> &
     pairs() const
     {
       return contact_pairs;
@@ -144,8 +155,12 @@ namespace knee_contact
     }
 
   private:
+    /**
+     * The mesh at refinement @p level: 0 on the first cycle; > 0 where the
+     * mesh input remeshes instead of refining (MeshInput::remeshes()).
+     */
     void
-    make_mesh();
+    make_mesh(const unsigned int level);
 
     void
     setup_system();
@@ -158,7 +173,7 @@ namespace knee_contact
     std::vector<CycleRecord>
     run_cycles(const Refinement::Strategy strategy,
                TimerOutput               &timer,
-               Results                   &results);
+               Results<dim>              &results);
 
     /**
      * Solve the contact problem for the current system_rhs, from the active
@@ -169,7 +184,7 @@ namespace knee_contact
     solve_contact(const std::vector<bool> &guess, const bool new_matrix);
 
     /** The derived quantities (compute_results()) of the current solution. */
-    Results
+    Results<dim>
     current_results() const;
 
     /** Evaluate loads and exact solutions at load parameter @p t. */
@@ -182,7 +197,7 @@ namespace knee_contact
      * pictures.
      */
     void
-    write_result_set(const Results                               &results,
+    write_result_set(const Results<dim>                          &results,
                      const std::vector<std::vector<CycleRecord>> &sequences,
                      TimerOutput                                 &timer);
 
@@ -193,7 +208,7 @@ namespace knee_contact
      * number of failed verification checks.
      */
     unsigned int
-    run_load_cases(const Results                               &first_results,
+    run_load_cases(const Results<dim>                          &first_results,
                    const std::vector<std::vector<CycleRecord>> &sequences,
                    TimerOutput                                 &timer);
 
@@ -205,30 +220,30 @@ namespace knee_contact
      * profile of every interface.
      */
     void
-    print_results(const Results &results) const;
+    print_results(const Results<dim> &results) const;
 
     std::string scene_file;
 
-    MeshInput          mesh_input;
-    Materials          materials;
-    BoundaryConditions boundary_conditions;
-    ContactInterfaces  contact_interfaces;
-    ActiveSetSolver    active_set_solver;
-    LoadCases          load_cases;
-    OutputWriter       output_writer;
-    Verification       verification;
-    Refinement         refinement;
+    MeshInput<dim>          mesh_input;
+    Materials<dim>          materials;
+    BoundaryConditions<dim> boundary_conditions;
+    ContactInterfaces       contact_interfaces;
+    ActiveSetSolver         active_set_solver;
+    LoadCases               load_cases;
+    OutputWriter<dim>       output_writer;
+    Verification<dim>       verification;
+    Refinement              refinement;
 
-    Triangulation<2> triangulation;
-    // FE_Q(1)^2 or FE_SimplexP(1)^2, by the mesh's cells (make_mesh).
-    std::unique_ptr<FiniteElement<2>> fe;
-    DoFHandler<2>                     dof_handler;
+    Triangulation<dim> triangulation;
+    // FE_Q(1)^dim or FE_SimplexP(1)^dim, by the mesh's cells (make_mesh).
+    std::unique_ptr<FiniteElement<dim>> fe;
+    DoFHandler<dim>                     dof_handler;
     std::vector<unsigned int>         body_of_cell;
     unsigned int                      n_bodies = 0;
     std::vector<std::string>          body_names;
 
     AffineConstraints<double> constraints;
-    std::vector<ContactPair>  contact_pairs;
+    ContactPairs<dim>         contact_pairs;
     SparsityPattern           sparsity_pattern;
     SparseMatrix<double>      system_matrix;
     Vector<double>            system_rhs;
@@ -243,7 +258,7 @@ namespace knee_contact
     std::map<std::string, double> solver_figures;
     std::string                   solver_name;
     /** Positions and slave lengths of the last cycle's active pairs. */
-    std::vector<std::pair<Point<2>, double>> previous_contact;
+    std::vector<std::pair<Point<dim>, double>> previous_contact;
 
     mutable std::ostringstream quiet;
   };

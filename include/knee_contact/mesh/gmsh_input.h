@@ -47,10 +47,12 @@ namespace knee_contact
      * Check the structure of an ASCII .msh file (version 2.2 or 4.1)
      * against its header: section order, counts against the file's size,
      * node tags unique and referenced nodes present, element types deal.II
-     * reads (points, lines, triangles, quadrilaterals), finite coordinates.
-     * The error names the file, the line and what is wrong.
+     * reads (points, lines, triangles, quadrilaterals, tetrahedra,
+     * hexahedra), finite coordinates, a physical group on every cell. The
+     * error names the file, the line and what is wrong. Returns the
+     * dimension of the cells: 3 if there are tetrahedra or hexahedra, else 2.
      */
-    void
+    unsigned int
     check_msh(const std::string &file);
   } // namespace gmsh_input
 } // namespace knee_contact

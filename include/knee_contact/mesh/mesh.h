@@ -18,13 +18,26 @@ namespace knee_contact
   using namespace dealii;
 
   /**
-   * One Triangulation<2> holding all bodies: read from a mesh file (Gmsh
-   * .msh or .geo, which the gmsh program meshes first; Abaqus .inp; legacy
-   * VTK .vtk) or generated from rectangles. Physical
-   * surfaces are material ids and physical curves boundary ids. Bodies that
-   * share vertices are bonded; bodies in contact must have distinct
-   * (possibly coincident) vertices on their interface.
+   * The dimension of the scene @p scene_file: 3 if its mesh file has
+   * volume cells (tetrahedra, hexahedra; a .geo is meshed to find out, and
+   * the mesh is kept for MeshInput to read), else 2. Errors of the mesh
+   * file are thrown here, as MeshInput would.
    */
+  unsigned int
+  scene_dimension(ParameterHandler &prm, const std::string &scene_file);
+
+
+
+  /**
+   * One Triangulation<dim> holding all bodies: read from a mesh file (Gmsh
+   * .msh or .geo, which the gmsh program meshes first; in 2D also Abaqus
+   * .inp, VTK .vtk/.vtu, UCD) or generated from rectangles (2D). Physical
+   * surfaces (2D) or volumes (3D) are material ids, physical curves (2D) or
+   * surfaces (3D) boundary ids. Bodies that share vertices are bonded;
+   * bodies in contact must have distinct (possibly coincident) vertices on
+   * their interface.
+   */
+  template <int dim>
   class MeshInput
   {
   public:
@@ -39,7 +52,17 @@ namespace knee_contact
      * globally as asked.
      */
     void
-    create(Triangulation<2> &triangulation) const;
+    create(Triangulation<dim> &triangulation,
+           const unsigned int  level = 0) const;
+
+    /**
+     * Whether refinement cycles remesh instead of refining @p triangulation:
+     * for tetrahedra from a .geo, gmsh meshes it anew at half the size per
+     * level (create() with level > 0), since deal.II 9.4's refinement of
+     * tetrahedra degrades them.
+     */
+    bool
+    remeshes(const Triangulation<dim> &triangulation) const;
 
   private:
     struct Rectangle
@@ -57,24 +80,35 @@ namespace knee_contact
      * quadrilaterals, adaptive refinement).
      */
     void
-    read_file(Triangulation<2> &triangulation) const;
+    read_file(Triangulation<dim> &triangulation,
+              const unsigned int  level) const;
 
-    mesh_readers::Description
-    read_gmsh() const;
+    /** The Gmsh mesh at refinement @p level (see remeshes()). */
+    mesh_readers::Description<dim>
+    read_gmsh(const unsigned int level) const;
 
     /**
      * Split @p mesh's triangles where needed (see read_file) and make
      * @p triangulation of it.
      */
     void
-    finish(mesh_readers::Description &mesh,
-           Triangulation<2>          &triangulation) const;
+    finish(mesh_readers::Description<dim> &mesh,
+           Triangulation<dim>             &triangulation) const;
 
-    mesh_readers::Description
+    mesh_readers::Description<2>
     read_vtk() const;
 
+    /** Source = rectangles (2D only: scene_dimension() gives 2). */
     void
-    make_rectangles(Triangulation<2> &triangulation) const;
+    make_rectangles(Triangulation<dim> &triangulation) const;
+
+    void
+    make_rectangles_2d(Triangulation<2> &triangulation) const;
+
+    /** Attach a PolarManifold (2D) or SphericalManifold (3D) to every id of
+     * circular_boundaries. */
+    void
+    attach_manifolds(Triangulation<dim> &triangulation) const;
 
     enum class Source
     {
@@ -89,7 +123,7 @@ namespace knee_contact
     std::vector<Rectangle>                 rectangles;
     double                                 rotation_degrees = 0;
     unsigned int                           n_refinements    = 0;
-    std::map<types::boundary_id, Point<2>> circular_boundaries;
+    std::map<types::boundary_id, Point<dim>> circular_boundaries;
     bool                                   split_triangles = false;
     enum class RectangleCells
     {
@@ -116,15 +150,17 @@ namespace knee_contact
    * the connected sets of cells that share vertices. Numbered 0, 1, ... in the
    * order of their first cell, so numbering is deterministic.
    */
+  template <int dim>
   std::vector<unsigned int>
-  compute_body_ids(const Triangulation<2> &triangulation,
-                   unsigned int           &n_bodies);
+  compute_body_ids(const Triangulation<dim> &triangulation,
+                   unsigned int             &n_bodies);
   /**
    * Refuse a mesh with an inverted, degenerate or non-convex cell, with the
    * cell's place (on the coarse mesh and after every refinement).
    */
+  template <int dim>
   void
-  check_cells(const Triangulation<2> &triangulation);
+  check_cells(const Triangulation<dim> &triangulation);
 } // namespace knee_contact
 
 #endif

@@ -21,13 +21,15 @@ namespace knee_contact
   namespace mesh_readers
   {
     /**
-     * A coarse mesh as deal.II's create_triangulation takes it.
+     * A coarse mesh as deal.II's create_triangulation takes it. The readers
+     * of this file read 2D meshes; 3D meshes come from Gmsh (MeshInput).
      */
+    template <int dim = 2>
     struct Description
     {
-      std::vector<Point<2>>    vertices;
-      std::vector<CellData<2>> cells;
-      SubCellData              subcells;
+      std::vector<Point<dim>>    vertices;
+      std::vector<CellData<dim>> cells;
+      SubCellData                subcells;
     };
 
     /**
@@ -42,7 +44,7 @@ namespace knee_contact
      * takes ids only from names of the form EB<n>, Material-<n>, SS<n>,
      * and trusts numbering and counts.
      */
-    Description
+    Description<2>
     read_abaqus(const std::string                         &file,
                 const std::map<std::string, unsigned int> &element_sets,
                 const std::map<std::string, unsigned int> &boundary_sets);
@@ -54,7 +56,7 @@ namespace knee_contact
      * hand: deal.II 9.4's read_ucd reads quadrilaterals only and trusts
      * counts and node numbers.
      */
-    Description
+    Description<2>
     read_ucd(const std::string &file);
 
     /**
@@ -66,7 +68,7 @@ namespace knee_contact
      * ParaView, VTK and meshio write them. Written by hand: deal.II 9.4's
      * read_vtu reads only the files deal.II itself wrote.
      */
-    Description
+    Description<2>
     read_vtu(const std::string &file);
 
     /**
@@ -87,7 +89,7 @@ namespace knee_contact
      */
     void
     split_into_quadrilaterals(
-      Description                                  &mesh,
+      Description<2>                               &mesh,
       const std::map<types::boundary_id, Point<2>> &circles);
   } // namespace mesh_readers
 } // namespace knee_contact

@@ -32,17 +32,19 @@ namespace knee_contact
     sliding
   };
 
+  template <int dim>
   struct BoundaryCondition
   {
     std::string                        name;
     BoundaryType                       type = BoundaryType::displacement;
     std::set<types::boundary_id>       ids;
     ComponentMask                      mask;
-    std::unique_ptr<FunctionParser<2>> function;
+    std::unique_ptr<FunctionParser<dim>> function;
   };
 
 
 
+  template <int dim>
   class BoundaryConditions
   {
   public:
@@ -56,7 +58,7 @@ namespace knee_contact
      * Throw if a boundary id named in the scene is missing from the mesh.
      */
     void
-    check_mesh(const Triangulation<2> &triangulation) const;
+    check_mesh(const Triangulation<dim> &triangulation) const;
 
     /**
      * Constraints of Gamma_u and Gamma_o (the seed's eq. (13), first three
@@ -66,7 +68,7 @@ namespace knee_contact
      * boundaries. Where a vertex lies on Gamma_u and Gamma_o, Gamma_u wins.
      */
     void
-    make_constraints(const DoFHandler<2>       &dof_handler,
+    make_constraints(const DoFHandler<dim>     &dof_handler,
                      AffineConstraints<double> &constraints) const;
 
     /**
@@ -77,14 +79,14 @@ namespace knee_contact
     void
     set_load_parameter(const double t);
 
-    const std::vector<BoundaryCondition> &
+    const std::vector<BoundaryCondition<dim>> &
     conditions() const
     {
       return list;
     }
 
   private:
-    std::vector<BoundaryCondition> list;
+    std::vector<BoundaryCondition<dim>> list;
   };
 } // namespace knee_contact
 

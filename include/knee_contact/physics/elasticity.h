@@ -21,18 +21,19 @@ namespace knee_contact
    * unconstrained pair for the residual d - C x (reactions and contact
    * forces).
    */
+  template <int dim>
   class ElasticityAssembler
   {
   public:
-    ElasticityAssembler(const Materials          &materials,
-                        const BoundaryConditions &boundary_conditions);
+    ElasticityAssembler(const Materials<dim>          &materials,
+                        const BoundaryConditions<dim> &boundary_conditions);
 
     /**
      * @p matrix must be initialised with a sparsity pattern; it and @p rhs
      * are overwritten. Cells are assembled in parallel by WorkStream.
      */
     void
-    assemble(const DoFHandler<2>  &dof_handler,
+    assemble(const DoFHandler<dim>  &dof_handler,
              SparseMatrix<double> &matrix,
              Vector<double>       &rhs) const;
 
@@ -41,16 +42,16 @@ namespace knee_contact
      * the body forces and tractions at the load parameter last set.
      */
     void
-    assemble_rhs(const DoFHandler<2> &dof_handler, Vector<double> &rhs) const;
+    assemble_rhs(const DoFHandler<dim> &dof_handler, Vector<double> &rhs) const;
 
   private:
     void
-    assemble(const DoFHandler<2>  &dof_handler,
+    assemble(const DoFHandler<dim>  &dof_handler,
              SparseMatrix<double> *matrix,
              Vector<double>       &rhs) const;
 
-    const Materials          &materials;
-    const BoundaryConditions &boundary_conditions;
+    const Materials<dim>          &materials;
+    const BoundaryConditions<dim> &boundary_conditions;
   };
 } // namespace knee_contact
 

@@ -73,6 +73,21 @@ namespace knee_contact
         .reference_cell()
         .template get_gauss_type_quadrature<dim>(n);
     }
+
+    /**
+     * Gauss rule with @p n points per direction on the faces of the cells
+     * of @p dof_handler (QGauss on lines and quadrilaterals, QGaussSimplex
+     * on the triangles of tetrahedra).
+     */
+    template <int dim>
+    inline Quadrature<dim - 1>
+    face_quadrature(const DoFHandler<dim> &dof_handler, const unsigned int n)
+    {
+      return dof_handler.get_fe()
+        .reference_cell()
+        .face_reference_cell(0)
+        .template get_gauss_type_quadrature<dim - 1>(n);
+    }
   } // namespace elements
 } // namespace knee_contact
 

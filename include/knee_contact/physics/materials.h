@@ -17,8 +17,10 @@ namespace knee_contact
 
   /**
    * Isotropic linear elastic material of one material id: Hooke's law
-   * tau_ij = c_ijkl e_kl, the seed's eq. (2), in plane strain or plane stress.
+   * tau_ij = c_ijkl e_kl, the seed's eq. (2); in 2D in plane strain or plane
+   * stress.
    */
+  template <int dim>
   struct Material
   {
     std::string name;
@@ -33,28 +35,28 @@ namespace knee_contact
      * Q1 elements as nu approaches 1/2.
      */
     bool                               reduced_volumetric = false;
-    std::unique_ptr<FunctionParser<2>> body_force;
+    std::unique_ptr<FunctionParser<dim>> body_force;
     /** The body force is written as zeros: nothing to integrate. */
     bool body_force_is_zero = false;
 
     /**
-     * In-plane stress from in-plane strain.
+     * Stress from strain (in 2D the in-plane components).
      */
-    SymmetricTensor<2, 2>
-    stress(const SymmetricTensor<2, 2> &strain) const;
+    SymmetricTensor<2, dim>
+    stress(const SymmetricTensor<2, dim> &strain) const;
 
     /**
-     * The out-of-plane stress tau_zz: nu (tau_xx + tau_yy) in plane strain,
-     * zero in plane stress.
+     * 2D: the out-of-plane stress tau_zz, nu (tau_xx + tau_yy) in plane
+     * strain, zero in plane stress. 3D: tau_zz itself.
      */
     double
-    stress_zz(const SymmetricTensor<2, 2> &stress) const;
+    stress_zz(const SymmetricTensor<2, dim> &stress) const;
 
     /**
-     * Von Mises stress including tau_zz.
+     * Von Mises stress (in 2D including tau_zz).
      */
     double
-    von_mises(const SymmetricTensor<2, 2> &stress) const;
+    von_mises(const SymmetricTensor<2, dim> &stress) const;
   };
 
 
@@ -63,6 +65,7 @@ namespace knee_contact
    * The table of materials by material id, read from the subsection
    * "Materials" of the scene file.
    */
+  template <int dim>
   class Materials
   {
   public:
@@ -77,9 +80,9 @@ namespace knee_contact
      * material.
      */
     void
-    check_mesh(const Triangulation<2> &triangulation) const;
+    check_mesh(const Triangulation<dim> &triangulation) const;
 
-    const Material &
+    const Material<dim> &
     operator[](const types::material_id id) const;
 
     /**
@@ -98,7 +101,7 @@ namespace knee_contact
     set_load_parameter(const double t);
 
   private:
-    std::map<types::material_id, Material> materials;
+    std::map<types::material_id, Material<dim>> materials;
   };
 } // namespace knee_contact
 

@@ -1,7 +1,7 @@
 #ifndef knee_contact_rigid_modes_h
 #define knee_contact_rigid_modes_h
 
-#include <knee_contact/contact/contact.h>
+#include <knee_contact/solver/contact_row.h>
 
 #include <deal.II/lac/affine_constraints.h>
 
@@ -15,20 +15,23 @@ namespace knee_contact
   using namespace dealii;
 
   /**
-   * Detects rigid motions that no constraint holds, before a factorisation
-   * would fail or return garbage (the seed's Remark 5: C is only positive
-   * semidefinite per body). Every body has three rigid modes (translation in
-   * x and y, rotation); the system is solvable iff no combination of them
-   * satisfies all Gamma_u, Gamma_o and active contact rows homogeneously.
-   * The test is the null space of the small Gram matrix of those rows
-   * evaluated on the modes.
+   * The test the active-set loop asks before it factorises: does a rigid
+   * motion stay free of every constraint? Dimension-free, so that the
+   * solver is; RigidModes<dim> answers it.
    */
-  class RigidModes
+  class RigidModeCheck
   {
   public:
-    RigidModes(const DoFHandler<2>             &dof_handler,
-               const std::vector<unsigned int> &body_of_cell,
-               const std::vector<std::string>  &body_names);
+    virtual ~RigidModeCheck() = default;
+
+    /**
+     * The description of the first free motion under @p base and the
+     * active rows of @p rows, or an empty string if every body is held.
+     */
+    virtual std::string
+    free_motion(const AffineConstraints<double> &base,
+                const std::vector<ContactRow>   &rows,
+                const std::vector<bool>         &active) const = 0;
 
     /**
      * Throw an ExcMessage naming the body and the free motion if the
@@ -37,24 +40,43 @@ namespace knee_contact
      */
     void
     check(const AffineConstraints<double> &base,
-          const std::vector<ContactPair>  &pairs,
+          const std::vector<ContactRow>   &rows,
           const std::vector<bool>         &active,
           const std::string               &context) const;
+  };
 
-    /**
-     * The same test; returns the description of the first free motion, or
-     * an empty string if every body is held.
-     */
+
+
+  /**
+   * Detects rigid motions that no constraint holds, before a factorisation
+   * would fail or return garbage (the seed's Remark 5: C is only positive
+   * semidefinite per body). Every body has dim (dim + 1) / 2 translations
+   * and dim (dim - 1) / 2 rotations: three in 2D, six in 3D; the system is
+   * solvable iff no combination of them satisfies all Gamma_u, Gamma_o and
+   * active contact rows homogeneously. The test is the null space of the
+   * small Gram matrix of those rows evaluated on the modes.
+   */
+  template <int dim>
+  class RigidModes : public RigidModeCheck
+  {
+  public:
+    RigidModes(const DoFHandler<dim>           &dof_handler,
+               const std::vector<unsigned int> &body_of_cell,
+               const std::vector<std::string>  &body_names);
+
     std::string
     free_motion(const AffineConstraints<double> &base,
-                const std::vector<ContactPair>  &pairs,
-                const std::vector<bool>         &active) const;
+                const std::vector<ContactRow>   &rows,
+                const std::vector<bool>         &active) const override;
+
+    /** Modes per body: translations, then rotations. */
+    static constexpr unsigned int n_modes = dim * (dim + 1) / 2;
 
   private:
     std::vector<unsigned int> dof_body;
     std::vector<unsigned int> dof_component;
-    std::vector<Point<2>>     dof_position;
-    std::vector<Point<2>>     centre;
+    std::vector<Point<dim>>   dof_position;
+    std::vector<Point<dim>>   centre;
     std::vector<double>       size;
     std::vector<std::string>  names;
   };

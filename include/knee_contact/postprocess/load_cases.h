@@ -43,6 +43,7 @@ namespace knee_contact
     /**
      * The figures of one case, for the table.
      */
+    template <int dim>
     struct Record
     {
       double       t            = 0;
@@ -50,7 +51,7 @@ namespace knee_contact
       bool         converged    = true;
       /** Wall time of the case's solve [s]: load vector to displacement. */
       double  solve_time = 0;
-      Results results;
+      Results<dim> results;
     };
 
     /**
@@ -58,17 +59,19 @@ namespace knee_contact
      * applied load, the reaction of every Gamma_u/Gamma_o boundary id, and
      * per interface active pairs, force, peak pressure and contact length.
      */
+    template <int dim>
     static void
-    write_csv(const std::vector<Record> &records, std::ostream &out);
+    write_csv(const std::vector<Record<dim>> &records, std::ostream &out);
 
     /**
      * The same table, shorter, on the terminal; the solve times only if
      * @p with_times (test output must not depend on the machine).
      */
+    template <int dim>
     static void
-    print_table(const std::vector<Record> &records,
-                const bool                 with_times,
-                std::ostream              &out);
+    print_table(const std::vector<Record<dim>> &records,
+                const bool                      with_times,
+                std::ostream                   &out);
 
     /**
      * The case's folder name: case_000, case_001, ...

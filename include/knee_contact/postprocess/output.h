@@ -29,6 +29,7 @@ namespace knee_contact
    * run go into a staging folder that replaces the output folder in one
    * step at the end (ResultFolder), so the folder never mixes two runs.
    */
+  template <int dim>
   class OutputWriter
   {
   public:
@@ -52,31 +53,32 @@ namespace knee_contact
     commit();
 
     void
-    write_vtu(const DoFHandler<2>             &dof_handler,
+    write_vtu(const DoFHandler<dim>           &dof_handler,
               const std::vector<unsigned int> &body_of_cell,
               const Vector<double>            &solution,
-              const Materials                 &materials,
-              const std::vector<ContactPair>  &pairs,
+              const Materials<dim>            &materials,
+              const ContactPairs<dim>         &pairs,
               const ContactSolution           &contact,
-              const Results                   &results) const;
+              const Results<dim>              &results) const;
 
     void
-    write_contact_csv(const ContactInterfaces        &interfaces,
-                      const std::vector<ContactPair> &pairs,
-                      const Vector<double>           &solution,
-                      const ContactSolution          &contact,
-                      const Results                  &results) const;
+    write_contact_csv(const ContactInterfaces &interfaces,
+                      const ContactPairs<dim> &pairs,
+                      const Vector<double>    &solution,
+                      const ContactSolution   &contact,
+                      const Results<dim>      &results) const;
 
     /**
-     * cells.csv: every cell's material and body id and, at its vertices
-     * (counter-clockwise), position, displacement and tau_yy; the data of the
-     * pictures.
+     * The data of the pictures: 2D cells.npy, every cell's material and body
+     * id and, at its vertices (counter-clockwise), position, displacement
+     * and tau_yy; 3D surface.npy, the same for every boundary face with von
+     * Mises instead of tau_yy.
      */
     void
-    write_cells(const DoFHandler<2>             &dof_handler,
+    write_cells(const DoFHandler<dim>           &dof_handler,
                 const std::vector<unsigned int> &body_of_cell,
                 const Vector<double>            &solution,
-                const Results                   &results) const;
+                const Results<dim>              &results) const;
 
     /**
      * Run scripts/@p script (Debian's python3 with matplotlib) on the
@@ -107,9 +109,9 @@ namespace knee_contact
      * its phase times and sizes (section "solver").
      */
     void
-    write_summary(const Results                       &results,
+    write_summary(const Results<dim>                  &results,
                   const ContactSolution               &contact,
-                  const Materials                     &materials,
+                  const Materials<dim>                &materials,
                   const std::map<std::string, double> &wall_times,
                   const std::string                   &solver,
                   const std::map<std::string, double> &solver_figures) const;
@@ -157,7 +159,7 @@ namespace knee_contact
     std::string                                   output_folder;
     double                                        magnification = 10;
     bool                                          pictures      = true;
-    std::vector<std::pair<std::string, Point<2>>> labels;
+    std::vector<std::pair<std::string, Point<dim>>> labels;
     bool                                          terminal_test = false;
     bool                                          write_files   = true;
   };

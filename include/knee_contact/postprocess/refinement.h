@@ -47,15 +47,16 @@ namespace knee_contact
      * each cell so that it estimates the energy norm error a(e, e)^1/2
      * across materials; refinement by fixed fraction of the estimate.
      */
+    template <int dim>
     void
-    refine(const Strategy                  strategy,
-           Triangulation<2>               &triangulation,
-           const DoFHandler<2>            &dof_handler,
-           const Vector<double>           &solution,
-           const Materials                &materials,
-           const ContactInterfaces        &interfaces,
-           const std::vector<ContactPair> &pairs,
-           const ContactSolution          &contact) const;
+    refine(const Strategy           strategy,
+           Triangulation<dim>      &triangulation,
+           const DoFHandler<dim>   &dof_handler,
+           const Vector<double>    &solution,
+           const Materials<dim>    &materials,
+           const ContactInterfaces &interfaces,
+           const ContactPairs<dim> &pairs,
+           const ContactSolution   &contact) const;
 
     static std::string
     name(const Strategy strategy);

@@ -9,6 +9,8 @@
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/vector.h>
 
+#include <deal.II/base/geometry_info.h>
+
 #include <deal.II/dofs/dof_handler.h>
 
 #include <array>
@@ -20,6 +22,7 @@ namespace knee_contact
 {
   using namespace dealii;
 
+  template <int dim>
   struct InterfaceResult
   {
     std::string name;
@@ -30,7 +33,7 @@ namespace knee_contact
     /** Sum of lambda_p [N/m]: the normal contact force per unit thickness. */
     double force = 0;
     /** The force vector on the slave body, -sum lambda_p n_p [N/m]. */
-    Tensor<1, 2> force_on_slave;
+    Tensor<1, dim> force_on_slave;
     double       max_pressure = 0;
     /** Length of slave boundary in contact, sum of the active shares [m]. */
     double contact_length = 0;
@@ -38,8 +41,10 @@ namespace knee_contact
 
   /**
    * The derived quantities of a solution: reactions, loads, equilibrium,
-   * stress ranges and contact results.
+   * stress ranges and contact results. Forces are per unit thickness
+   * [N/m] in 2D and [N] in 3D, energies [J/m] and [J].
    */
+  template <int dim>
   struct Results
   {
     unsigned int n_dofs  = 0;
@@ -48,36 +53,44 @@ namespace knee_contact
     std::string  elements;
     unsigned int n_bodies = 0;
     /** Reaction force per Gamma_u/Gamma_o boundary id [N/m]. */
-    std::map<types::boundary_id, Tensor<1, 2>> reactions;
+    std::map<types::boundary_id, Tensor<1, dim>> reactions;
     /** Total applied load: tractions plus body forces [N/m]. */
-    Tensor<1, 2> applied_load;
+    Tensor<1, dim> applied_load;
     /** |load + reactions| / max(|load|, sum |reactions|). */
     double equilibrium_residual = 0;
     /** a(u, u) [J/m]. */
     double energy           = 0;
     double max_displacement = 0;
     /**
-     * tau_yy [Pa] at the four vertices of each active cell (by
-     * active_cell_index(), deal.II's vertex order): what the pictures show.
+     * tau_yy [Pa] at the vertices of each active cell (by
+     * active_cell_index(), deal.II's vertex order; a simplex repeats its
+     * last vertex): what the 2D pictures show.
      */
-    std::vector<std::array<double, 4>> vertex_stress_yy;
+    std::vector<std::array<double, GeometryInfo<dim>::vertices_per_cell>>
+      vertex_stress_yy;
+    /** Von Mises stress [Pa] in the same places: the 3D pictures. */
+    std::vector<std::array<double, GeometryInfo<dim>::vertices_per_cell>>
+      vertex_von_mises;
     /** min and max tau_yy per material id [Pa], at cell vertices. */
     std::map<types::material_id, std::pair<double, double>> stress_yy_range;
-    std::vector<InterfaceResult>                            interfaces;
+    /** max von Mises stress per material id [Pa], at cell vertices. */
+    std::map<types::material_id, double> von_mises_max;
+    std::vector<InterfaceResult<dim>>    interfaces;
     /** Contact pressure lambda_p / length_p per pair [Pa]. */
     std::vector<double> pressure;
   };
 
-  Results
-  compute_results(const DoFHandler<2>             &dof_handler,
+  template <int dim>
+  Results<dim>
+  compute_results(const DoFHandler<dim>           &dof_handler,
                   const std::vector<unsigned int> &body_of_cell,
                   const SparseMatrix<double>      &matrix,
                   const Vector<double>            &rhs,
                   const Vector<double>            &solution,
-                  const Materials                 &materials,
-                  const BoundaryConditions        &boundary_conditions,
+                  const Materials<dim>            &materials,
+                  const BoundaryConditions<dim>   &boundary_conditions,
                   const ContactInterfaces         &interfaces,
-                  const std::vector<ContactPair>  &pairs,
+                  const ContactPairs<dim>         &pairs,
                   const ContactSolution           &contact);
 } // namespace knee_contact
 

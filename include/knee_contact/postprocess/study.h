@@ -35,11 +35,12 @@ namespace knee_contact
 
   /**
    * The cycles of one sequence as a deal.II ConvergenceTable with the
-   * observed rates (h ~ n_dofs^-1/2) of every error the scene has a
+   * observed rates (h ~ n_dofs^(-1/dimension)) of every error the scene has a
    * reference for; wall times only if @p with_times (not in test output).
    */
   void
   print_convergence_table(const std::vector<CycleRecord> &records,
+                          const unsigned int              dimension,
                           const bool                      with_times,
                           std::ostream                   &out);
 

@@ -59,6 +59,7 @@ namespace knee_contact
    * the KKT conditions of the contact problem. Each check prints one line
    * "check <what>: <value> <= <tolerance>: PASS|FAIL".
    */
+  template <int dim>
   class Verification
   {
   public:
@@ -69,11 +70,11 @@ namespace knee_contact
     parse_parameters(ParameterHandler &prm);
 
     Errors
-    compute_errors(const DoFHandler<2>            &dof_handler,
-                   const Vector<double>           &solution,
-                   const Materials                &materials,
-                   const std::vector<ContactPair> &pairs,
-                   const Results                  &results) const;
+    compute_errors(const DoFHandler<dim>   &dof_handler,
+                   const Vector<double>    &solution,
+                   const Materials<dim>    &materials,
+                   const ContactPairs<dim> &pairs,
+                   const Results<dim>      &results) const;
 
     /**
      * The checks of a study (Refinement/Strategy = compare) on its two
@@ -93,7 +94,7 @@ namespace knee_contact
      * return the number that failed.
      */
     unsigned int
-    check(const Results             &results,
+    check(const Results<dim>        &results,
           const ContactSolution     &contact,
           const bool                 has_contact,
           const std::vector<Errors> &errors,
@@ -109,9 +110,9 @@ namespace knee_contact
     set_load_parameter(const double t);
 
   private:
-    std::unique_ptr<FunctionParser<2>>          exact_displacement;
-    std::unique_ptr<FunctionParser<2>>          exact_stress;
-    std::unique_ptr<FunctionParser<2>>          exact_pressure;
+    std::unique_ptr<FunctionParser<dim>>        exact_displacement;
+    std::unique_ptr<FunctionParser<dim>>        exact_stress;
+    std::unique_ptr<FunctionParser<dim>>        exact_pressure;
     double                                      tolerance         = 1e-10;
     double                                      min_l2_rate       = 0;
     double                                      min_energy_rate   = 0;

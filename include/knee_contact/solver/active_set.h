@@ -1,18 +1,18 @@
 #ifndef knee_contact_active_set_h
 #define knee_contact_active_set_h
 
-#include <knee_contact/contact/contact.h>
+#include <knee_contact/solver/contact_row.h>
 #include <knee_contact/solver/contact_system.h>
 #include <knee_contact/physics/rigid_modes.h>
 
 #include <deal.II/base/parameter_handler.h>
 
 #include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/dynamic_sparsity_pattern.h>
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/sparsity_pattern.h>
 #include <deal.II/lac/vector.h>
 
-#include <deal.II/dofs/dof_handler.h>
 
 #include <ostream>
 #include <string>
@@ -100,8 +100,8 @@ namespace knee_contact
     solve(ContactSystem                   &system,
           const double                     force_scale,
           const AffineConstraints<double> &base,
-          const std::vector<ContactPair>  &pairs,
-          const RigidModes                &rigid_modes,
+          const std::vector<ContactRow>  &pairs,
+          const RigidModeCheck                &rigid_modes,
           const std::vector<bool>         &guess,
           std::ostream                    &log) const;
 
@@ -110,9 +110,9 @@ namespace knee_contact
      * @p pairs under @p base (see the comment in the code).
      */
     static void
-    make_sparsity_pattern(const DoFHandler<2>             &dof_handler,
+    make_sparsity_pattern(const DynamicSparsityPattern    &mesh_pattern,
                           const AffineConstraints<double> &base,
-                          const std::vector<ContactPair>  &pairs,
+                          const std::vector<ContactRow>  &pairs,
                           SparsityPattern                 &sparsity_pattern);
 
     /**
@@ -120,7 +120,7 @@ namespace knee_contact
      */
     static void
     make_constraints(const AffineConstraints<double> &base,
-                     const std::vector<ContactPair>  &pairs,
+                     const std::vector<ContactRow>  &pairs,
                      const std::vector<bool>         &active,
                      AffineConstraints<double>       &constraints);
 
@@ -132,7 +132,7 @@ namespace knee_contact
     static std::vector<double>
     multipliers(const Vector<double>            &residual,
                 const AffineConstraints<double> &base,
-                const std::vector<ContactPair>  &pairs,
+                const std::vector<ContactRow>  &pairs,
                 const std::vector<bool>         &active);
 
     /**
@@ -145,7 +145,7 @@ namespace knee_contact
                            const Vector<double>            &rhs,
                            const Vector<double>            &x,
                            const AffineConstraints<double> &base,
-                           const std::vector<ContactPair>  &pairs,
+                           const std::vector<ContactRow>  &pairs,
                            const std::vector<bool>         &active,
                            std::vector<double>             &excess,
                            std::vector<double>             &lambda);
@@ -155,7 +155,7 @@ namespace knee_contact
      * can be active), the scale of the complementarity residual.
      */
     static double
-    displacement_scale(const std::vector<ContactPair> &pairs,
+    displacement_scale(const std::vector<ContactRow> &pairs,
                        const Vector<double>           &x);
 
   private:

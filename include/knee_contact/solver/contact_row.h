@@ -1,0 +1,63 @@
+#ifndef knee_contact_contact_row_h
+#define knee_contact_contact_row_h
+
+#include <deal.II/base/types.h>
+
+#include <deal.II/lac/vector.h>
+
+#include <utility>
+#include <vector>
+
+namespace knee_contact
+{
+  using namespace dealii;
+
+  /**
+   * One row of the seed's contact constraint A x <= 0 (its eq. (13)), with
+   * the initial gap: a_p . x <= g_p, as the solver sees it. It knows dofs and
+   * coefficients only, no geometry (positions and normals are in
+   * ContactPoint, for output), so that the solver is the same in 2D and 3D
+   * and for every contact discretisation (node-to-node, node-to-segment,
+   * mortar) that makes rows.
+   */
+  struct ContactRow
+  {
+    /** The contact interface the row belongs to. */
+    unsigned int interface = 0;
+    /** g_p [m]. */
+    double gap = 0;
+    /**
+     * The row's weight [m in 2D, m^2 in 3D]: the slave vertex's share of the
+     * slave boundary; the multiplier divided by it is a pressure [Pa].
+     */
+    double length = 0;
+
+    /** The row a_p: (dof, coefficient). */
+    std::vector<std::pair<types::global_dof_index, double>> row;
+    /**
+     * The row with the Gamma_u and Gamma_o constraints substituted, over
+     * dofs those leave free, and its right hand side.
+     */
+    std::vector<std::pair<types::global_dof_index, double>> reduced_row;
+    double                                                  reduced_gap = 0;
+    /**
+     * The dof an active row eliminates (a free slave component if there is
+     * one, else a free master component); invalid if the row has no free
+     * dof left, i.e. Gamma_u or Gamma_o already decide it.
+     */
+    types::global_dof_index eliminated       = numbers::invalid_dof_index;
+    bool                    slave_eliminated = true;
+
+    /** a_p . x */
+    double
+    jump(const Vector<double> &x) const
+    {
+      double value = 0;
+      for (const auto &[dof, coefficient] : row)
+        value += coefficient * x(dof);
+      return value;
+    }
+  };
+} // namespace knee_contact
+
+#endif
