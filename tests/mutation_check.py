@@ -56,6 +56,10 @@ EXEMPT = [
     ("lame_sphere_octant.prm", r"^nu:",
      "analytic: u_r(a) is proportional to (1 - 2 nu) + 4 (1 + nu), so nu "
      "x 1.01 moves it by 0.1 %, below the finest mesh's L2 error (7.4e-3)"),
+    ("lame_sphere_octant.prm", r"^load:",
+     "P1 on these meshes is too stiff by about 0.7 % (measured): 1 % more "
+     "pressure cancels that and the L2 error falls to 3.4e-3 (measured); "
+     "E x 1.01, the same factor the other way, is killed"),
     ("sliding_rotated_square.prm", r"^geometry:",
      "homogeneous strain: u = eps x on a square of any size"),
     # Measured sensitivities (tests/knee_small.prm, knee_frontal_small.prm:
