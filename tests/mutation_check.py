@@ -56,6 +56,10 @@ EXEMPT = [
     ("lame_sphere_octant.prm", r"^nu:",
      "analytic: u_r(a) is proportional to (1 - 2 nu) + 4 (1 + nu), so nu "
      "x 1.01 moves it by 0.1 %, below the finest mesh's L2 error (7.4e-3)"),
+    ("lame_sphere_octant_sliding.prm", r"^(nu|load):",
+     "as lame_sphere_octant.prm: nu x 1.01 moves B by 0.06 % (analytic); "
+     "1 % more pressure offsets P1's stiffness (L2 error 5.8e-3, measured, "
+     "below the 6.5e-3 of the exact pressure); E x 1.01 is killed"),
     ("lame_sphere_octant.prm", r"^load:",
      "P1 on these meshes is too stiff by about 0.7 % (measured): 1 % more "
      "pressure cancels that and the L2 error falls to 3.4e-3 (measured); "

@@ -80,24 +80,36 @@ namespace knee_contact
 
 
 
-    double
-    to_double(const std::string &text, const std::string &parameter)
+    std::optional<double>
+    number(const std::string &text)
     {
-      double      value = 0;
+      // std::stod skips leading white space and stops at the first
+      // character that is not part of a number: the rest must be used too.
       std::size_t end   = 0;
+      double      value = 0;
       try
         {
           value = std::stod(text, &end);
         }
       catch (...)
         {
-          end = 0;
+          return std::nullopt;
         }
-      AssertThrow(end != 0 && Utilities::trim(text.substr(end)).empty() &&
-                    std::isfinite(value),
+      if (end == 0 || end != text.size() || !std::isfinite(value))
+        return std::nullopt;
+      return value;
+    }
+
+
+
+    double
+    to_double(const std::string &text, const std::string &parameter)
+    {
+      const auto value = number(Utilities::trim(text));
+      AssertThrow(value.has_value(),
                   ExcMessage("parameter '" + parameter + "': '" + text +
                              "' is not a finite number"));
-      return value;
+      return *value;
     }
 
 

@@ -169,12 +169,7 @@ namespace knee_contact
         // Written as zeros ("0; 0", the 2D default): assembly skips it.
         material.body_force_is_zero = true;
         for (const auto &part : input::split(prm.get("Body force"), ';'))
-          {
-            char        *end   = nullptr;
-            const double value = std::strtod(part.c_str(), &end);
-            material.body_force_is_zero &=
-              end != part.c_str() && *end == '\0' && value == 0;
-          }
+          material.body_force_is_zero &= input::number(part) == 0.;
         prm.leave_subsection();
       }
     prm.leave_subsection();

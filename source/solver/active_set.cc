@@ -272,57 +272,6 @@ namespace knee_contact
 
 
 
-  FullContactSystem::FullContactSystem(const SparseMatrix<double>      &matrix,
-                                       const AffineConstraints<double> &base,
-                                       const std::vector<ContactRow>  &pairs)
-    : matrix(matrix)
-    , base(base)
-    , pairs(pairs)
-    , system_matrix(matrix.get_sparsity_pattern())
-    , system_rhs(matrix.m())
-    , x(matrix.m())
-  {}
-
-
-
-  void
-  FullContactSystem::set_rhs(const Vector<double> &new_rhs)
-  {
-    rhs = &new_rhs;
-  }
-
-
-
-  void
-  FullContactSystem::solve(const std::vector<bool> &active,
-                           std::vector<double>     &excess,
-                           std::vector<double>     &lambda)
-  {
-    AffineConstraints<double> constraints;
-    ActiveSetSolver::make_constraints(base, pairs, active, constraints);
-    Assert(rhs != nullptr, ExcMessage("set_rhs() was not called"));
-    system_matrix.copy_from(matrix);
-    system_rhs = *rhs;
-    constraints.condense(system_matrix, system_rhs);
-    SparseDirectUMFPACK direct;
-    direct.initialize(system_matrix);
-    direct.vmult(x, system_rhs);
-    constraints.distribute(x);
-
-    ActiveSetSolver::excess_and_multipliers(
-      matrix, *rhs, x, base, pairs, active, excess, lambda);
-  }
-
-
-
-  double
-  FullContactSystem::displacement_scale() const
-  {
-    return ActiveSetSolver::displacement_scale(pairs, x);
-  }
-
-
-
   void
   ActiveSetSolver::excess_and_multipliers(const SparseMatrix<double> &matrix,
                                           const Vector<double>       &rhs,
@@ -354,14 +303,6 @@ namespace knee_contact
         for (const auto &entry : pair.reduced_row)
           scale = std::max(scale, std::abs(x(entry.first)));
     return scale;
-  }
-
-
-
-  void
-  FullContactSystem::solution(Vector<double> &result)
-  {
-    result = x;
   }
 
 

@@ -6,6 +6,7 @@
 #include <deal.II/base/point.h>
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -77,7 +78,15 @@ namespace knee_contact
     to_point(const std::string &text, const std::string &parameter);
 
     /**
-     * A finite double from @p text, or an error naming @p parameter.
+     * The finite number that is all of @p text, or nothing: the one number
+     * parser of scene files and mesh files (each caller words its error).
+     */
+    std::optional<double>
+    number(const std::string &text);
+
+    /**
+     * A finite double from @p text (white space around it allowed), or an
+     * error naming @p parameter.
      */
     double
     to_double(const std::string &text, const std::string &parameter);

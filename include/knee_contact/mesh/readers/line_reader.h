@@ -1,0 +1,214 @@
+#ifndef knee_contact_mesh_readers_line_reader_h
+#define knee_contact_mesh_readers_line_reader_h
+
+#include <knee_contact/core/input.h>
+#include <knee_contact/mesh/mesh_readers.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace knee_contact
+{
+  namespace mesh_readers
+  {
+    /**
+     * What the hand-written readers (Abaqus, UCD, VTK, VTU) share: one line
+     * reader whose errors name file and line, the field and number parsers,
+     * and the step from a ring of vertices to deal.II's cell.
+     */
+    namespace internal
+    {
+      /**
+       * A text file read line by line, with errors that name file and line.
+       */
+      class Lines
+      {
+      public:
+        explicit Lines(const std::string &file)
+          : file(file)
+          , in(file)
+        {
+          AssertThrow(in.good(),
+                      ExcMessage("Mesh/File: cannot open '" + file + "'"));
+          size = std::filesystem::file_size(file);
+        }
+
+        bool
+        next(std::string &line)
+        {
+          if (pending)
+            {
+              line    = held;
+              pending = false;
+              return true;
+            }
+          if (!std::getline(in, line))
+            return false;
+          ++number;
+          if (!line.empty() && line.back() == '\r')
+            line.pop_back();
+          return true;
+        }
+
+        /** Give @p line back: the next call of next() returns it again. */
+        void
+        put_back(const std::string &line)
+        {
+          held    = line;
+          pending = true;
+        }
+
+        [[noreturn]] void
+        fail(const std::string &what) const
+        {
+          throw std::runtime_error(
+            input::cap("Mesh/File: '" + file + "' line " +
+                       std::to_string(number) + ": " + what));
+        }
+
+        const std::string file;
+        std::uintmax_t    size   = 0;
+        unsigned long     number = 0;
+
+      private:
+        std::ifstream in;
+        std::string   held;
+        bool          pending = false;
+      };
+
+      inline std::string
+      upper(std::string text)
+      {
+        for (char &c : text)
+          c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+        return text;
+      }
+
+      inline std::string
+      trim(const std::string &text)
+      {
+        const auto first = text.find_first_not_of(" \t");
+        if (first == std::string::npos)
+          return "";
+        return text.substr(first, text.find_last_not_of(" \t") - first + 1);
+      }
+
+      inline std::vector<std::string>
+      fields(const std::string &line)
+      {
+        std::vector<std::string> result;
+        std::stringstream        stream(line);
+        std::string              field;
+        while (std::getline(stream, field, ','))
+          result.push_back(trim(field));
+        // "1, 2," has no third field.
+        if (!result.empty() && result.back().empty())
+          result.pop_back();
+        return result;
+      }
+
+      inline long long
+      to_integer(const std::string &text, const Lines &lines)
+      {
+        std::size_t end   = 0;
+        long long   value = 0;
+        try
+          {
+            value = std::stoll(text, &end);
+          }
+        catch (...)
+          {
+            end = 0;
+          }
+        if (end == 0 || end != text.size())
+          lines.fail("'" + text + "' is not an integer");
+        return value;
+      }
+
+      inline double
+      to_number(const std::string &text, const Lines &lines)
+      {
+        const auto value = input::number(text);
+        if (!value)
+          lines.fail("'" + text + "' is not a finite number");
+        return *value;
+      }
+
+      /**
+       * The value of "KEY=value" among the options of a keyword line, upper
+       * case, or "" if absent.
+       */
+      inline std::string
+      option(const std::vector<std::string> &keyword_fields,
+             const std::string              &key)
+      {
+        for (std::size_t i = 1; i < keyword_fields.size(); ++i)
+          {
+            const auto equal = keyword_fields[i].find('=');
+            if (equal != std::string::npos &&
+                upper(trim(keyword_fields[i].substr(0, equal))) == key)
+              return upper(trim(keyword_fields[i].substr(equal + 1)));
+          }
+        return "";
+      }
+
+      inline bool
+      has_flag(const std::vector<std::string> &keyword_fields,
+               const std::string              &flag)
+      {
+        for (std::size_t i = 1; i < keyword_fields.size(); ++i)
+          if (upper(keyword_fields[i]) == flag)
+            return true;
+        return false;
+      }
+
+      /**
+       * Abaqus' face k of a 2D element joins its nodes k and k+1 (the last
+       * back to the first).
+       */
+      inline std::pair<long long, long long>
+      face_nodes(const std::vector<long long> &nodes, const unsigned int k)
+      {
+        return {nodes[k], nodes[(k + 1) % nodes.size()]};
+      }
+
+      /**
+       * Add a triangle or quadrilateral whose @p vertices run round it, as
+       * Abaqus, UCD and VTK list them; deal.II's order is lexicographic
+       * (0 1 3 2 round a quadrilateral).
+       */
+      inline void
+      add_cell(Description<2>              &mesh,
+               std::vector<unsigned int> vertices,
+               const types::material_id  material_id)
+      {
+        if (vertices.size() == 4)
+          std::swap(vertices[2], vertices[3]);
+        CellData<2> cell(vertices.size());
+        cell.vertices    = vertices;
+        cell.material_id = material_id;
+        mesh.cells.push_back(cell);
+      }
+
+      inline void
+      add_boundary_line(Description<2>             &mesh,
+                        const unsigned int       a,
+                        const unsigned int       b,
+                        const types::boundary_id boundary_id)
+      {
+        CellData<1> line;
+        line.vertices    = {a, b};
+        line.boundary_id = boundary_id;
+        mesh.subcells.boundary_lines.push_back(line);
+      }
+    } // namespace internal
+  } // namespace mesh_readers
+} // namespace knee_contact
+
+#endif

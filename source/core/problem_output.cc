@@ -1,0 +1,308 @@
+// The files of a run: result sets, load cases and the results table
+// (ContactProblem's output, split from problem.cc by job).
+#include <knee_contact/core/problem.h>
+#include <knee_contact/physics/elasticity.h>
+
+#include <deal.II/base/data_out_base.h>
+#include <deal.II/base/timer.h>
+#include <deal.II/base/utilities.h>
+
+#include <cmath>
+#include <future>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+namespace knee_contact
+{
+  template <int dim>
+  void
+  ContactProblem<dim>::write_result_set(
+    const Results<dim>                          &results,
+    const std::vector<std::vector<CycleRecord>> &sequences,
+    TimerOutput                                 &timer)
+  {
+    // Declared first: if anything below throws, its destructor waits for
+    // the VTU thread before the objects it reads go.
+    std::future<void> vtu;
+    {
+      TimerOutput::Scope scope(timer, "output");
+      // The VTU (DataOut's patches and zlib: 95 % of the output time,
+      // measured 2.2 s of 2.3 s at 4.3e5 Hertz dofs) is written on a second
+      // thread while the other files, the summary and the pictures are
+      // made, and joined before the folder is committed; everything it
+      // reads is read-only by then.
+      vtu = std::async(std::launch::async, [&]() {
+        TimerOutput::Scope part(timer, "output: vtu");
+        output_writer.write_vtu(dof_handler,
+                                body_of_cell,
+                                displacement,
+                                materials,
+                                contact_pairs,
+                                contact_solution,
+                                results);
+      });
+      {
+        TimerOutput::Scope part(timer, "output: cells.npy");
+        output_writer.write_cells(dof_handler,
+                                  body_of_cell,
+                                  displacement,
+                                  results);
+      }
+      TimerOutput::Scope part(timer, "output: csv");
+      output_writer.write_contact_csv(contact_interfaces,
+                                      contact_pairs,
+                                      displacement,
+                                      contact_solution,
+                                      results);
+      std::size_t n_records = 0;
+      for (const auto &records : sequences)
+        n_records += records.size();
+      if (n_records > 1)
+        output_writer.write_file("study.csv", [&](std::ostream &out) {
+          std::vector<CycleRecord> all;
+          for (const auto &records : sequences)
+            all.insert(all.end(), records.begin(), records.end());
+          write_study_csv(all, out);
+        });
+    }
+    Utilities::System::MemoryStats memory;
+    Utilities::System::get_memory_stats(memory);
+    solver_figures["peak_memory_MB"] = memory.VmHWM / 1024.;
+    // Where the memory goes (deal.II's own accounting of its objects; the
+    // solver's factor is factor_memory_MB).
+    solver_figures["memory_mesh_MB"] =
+      triangulation.memory_consumption() / 1048576.;
+    solver_figures["memory_dofs_MB"] =
+      dof_handler.memory_consumption() / 1048576.;
+    solver_figures["memory_matrix_MB"] =
+      (sparsity_pattern.memory_consumption() +
+       system_matrix.memory_consumption()) /
+      1048576.;
+    // The pictures read summary.json; a picture failure is kept in it
+    // as a warning.
+    const auto summary = [&]() {
+      output_writer.write_summary(results,
+                                  contact_solution,
+                                  materials,
+                                  timer.get_summary_data(
+                                    TimerOutput::total_wall_time),
+                                  solver_name,
+                                  solver_figures);
+    };
+    summary();
+    {
+      TimerOutput::Scope scope(timer, "pictures");
+      std::string        message;
+      if (!output_writer.run_script(dim == 2 ? "plot_results.py"
+                                             : "plot_results_3d.py",
+                                    message) ||
+          (sequences.size() > 1 &&
+           !output_writer.run_script("plot_study.py", message)))
+        output_writer.warn("no pictures: " + message);
+    }
+    {
+      TimerOutput::Scope scope(timer, "output");
+      vtu.get();
+    }
+    // Again, with the VTU's time and any warning of the pictures.
+    summary();
+  }
+
+
+
+  template <int dim>
+  unsigned int
+  ContactProblem<dim>::run_load_cases(
+    const Results<dim>                          &first_results,
+    const std::vector<std::vector<CycleRecord>> &sequences,
+    TimerOutput                                 &timer)
+  {
+    const std::vector<double>          &t = load_cases.values();
+    std::vector<LoadCases::Record<dim>> records;
+    const auto                     record = [&](const double   t_case,
+                            const double   solve_time,
+                            const Results<dim> &results) {
+      LoadCases::Record<dim> r;
+      r.t            = t_case;
+      r.n_iterations = contact_solution.n_iterations;
+      r.converged    = contact_solution.converged;
+      r.solve_time   = solve_time;
+      r.results      = results;
+      // The table needs the figures, not the per-cell and per-pair fields
+      // (tens of MB per case on a fine mesh).
+      decltype(r.results.vertex_stress_yy)().swap(r.results.vertex_stress_yy);
+      decltype(r.results.vertex_von_mises)().swap(r.results.vertex_von_mises);
+      std::vector<double>().swap(r.results.pressure);
+      records.push_back(std::move(r));
+    };
+    record(t[0], solver_figures["contact_solve"], first_results);
+    if (output_writer.enabled())
+      {
+        output_writer.set_subfolder(LoadCases::folder(0));
+        write_result_set(first_results, sequences, timer);
+      }
+
+    unsigned int n_failed = 0;
+    for (unsigned int c = 1; c < t.size() && contact_solution.converged; ++c)
+      {
+        std::cout << "load case " << c << ": t = " << t[c] << std::endl;
+        set_load_parameter(t[c]);
+        Timer clock;
+        {
+          TimerOutput::Scope scope(timer, "load cases: assembly");
+          ElasticityAssembler<dim>(materials, boundary_conditions)
+            .assemble_rhs(dof_handler, system_rhs);
+        }
+        {
+          TimerOutput::Scope scope(timer, "load cases: solve");
+          // The previous case's active set is the guess: loads along a
+          // cycle change little from case to case.
+          solve_contact(contact_solution.active, false);
+        }
+        const double solve_time = clock.wall_time();
+        Results<dim> results;
+        {
+          TimerOutput::Scope scope(timer, "postprocess");
+          results = current_results();
+        }
+        print_results(results);
+        const Errors errors = verification.compute_errors(
+          dof_handler, displacement, materials, contact_pairs, results);
+        n_failed += verification.check(results,
+                                       contact_solution,
+                                       !contact_pairs.empty(),
+                                       {errors},
+                                       {double(dof_handler.n_dofs())},
+                                       std::cout);
+        record(t[c], solve_time, results);
+        if (output_writer.enabled())
+          {
+            output_writer.set_subfolder(LoadCases::folder(c));
+            write_result_set(results, {}, timer);
+          }
+      }
+
+    LoadCases::print_table(records, !output_writer.test_mode(), std::cout);
+    if (output_writer.enabled())
+      {
+        output_writer.set_subfolder("");
+        output_writer.write_file("load_cases.csv", [&](std::ostream &out) {
+          LoadCases::write_csv(records, out);
+        });
+        // A ParaView series: open load_cases.pvd and step through t.
+        output_writer.write_file("load_cases.pvd", [&](std::ostream &out) {
+          std::vector<std::pair<double, std::string>> series;
+          for (unsigned int c = 0; c < records.size(); ++c)
+            series.emplace_back(records[c].t,
+                                LoadCases::folder(c) + "/solution.vtu");
+          DataOutBase::write_pvd_record(out, series);
+        });
+        TimerOutput::Scope scope(timer, "pictures");
+        std::string        message;
+        if (!output_writer.run_script("plot_load_cases.py", message))
+          std::cout << "knee_contact: warning: no load-case plot: " << message
+                    << std::endl;
+      }
+    return n_failed;
+  }
+
+
+
+  template <int dim>
+  void
+  ContactProblem<dim>::print_results(const Results<dim> &results) const
+  {
+    std::ostream &out = std::cout;
+    // Per unit thickness in 2D.
+    const std::string force_unit  = dim == 2 ? "[N/m]" : "[N]  ";
+    const std::string energy_unit = dim == 2 ? "[J/m]" : "[J]  ";
+    const auto        list = [](const auto &v, const auto &shown) {
+      std::ostringstream text;
+      text << std::scientific << std::setprecision(6);
+      for (unsigned int d = 0; d < dim; ++d)
+        text << (d == 0 ? "(" : ", ") << shown(v[d]);
+      return text.str() + ")";
+    };
+    out << std::scientific << std::setprecision(6);
+    out << "results:\n"
+        << "  dofs " << results.n_dofs << ", cells " << results.n_cells
+        << ", bodies " << results.n_bodies << "\n"
+        << "  applied load " << force_unit << "           "
+        << list(results.applied_load, [](const double f) { return f; })
+        << "\n";
+    // A reaction component that is zero by physics comes out as round-off
+    // of the force scale (1e-8 N/m beside 1e6 N/m); printed as it is, it
+    // would make every comparison of this table with an earlier run fail on
+    // noise. Components below 1e-10 of the force scale (the largest
+    // force, or E max |u| where no force is applied: a rigid motion) are
+    // shown as 0; so are an energy below 1e-10 E max|u|^2 and a stress
+    // below 1e-12 E.
+    const double E = materials.max_youngs_modulus();
+    double       force_scale =
+      std::max(results.applied_load.norm(), E * results.max_displacement);
+    for (const auto &[id, reaction] : results.reactions)
+      force_scale = std::max(force_scale, reaction.norm());
+    const auto shown = [force_scale](const double f) {
+      return std::abs(f) <= 1e-10 * force_scale ? 0. : f;
+    };
+    const double energy_noise =
+      1e-10 * E * results.max_displacement * results.max_displacement;
+    const auto shown_stress = [E](const double s) {
+      return std::abs(s) <= 1e-12 * E ? 0. : s;
+    };
+    for (const auto &[id, reaction] : results.reactions)
+      out << "  reaction at boundary id " << std::setw(3) << id << " "
+          << force_unit << " " << list(reaction, shown) << "\n";
+    out << "  equilibrium residual         " << std::setprecision(2)
+        << results.equilibrium_residual << std::setprecision(6) << "\n"
+        << "  energy a(u,u) " << energy_unit << "          "
+        << (std::abs(results.energy) <= energy_noise ? 0. : results.energy)
+        << "\n"
+        << "  max |u| [m]                  " << results.max_displacement
+        << "\n";
+    for (const auto &[id, range] : results.stress_yy_range)
+      out << "  tau_yy [Pa] in " << std::left << std::setw(14)
+          << materials[id].name << std::right << " ["
+          << shown_stress(range.first) << ", " << shown_stress(range.second)
+          << "]\n";
+    if (dim == 3)
+      for (const auto &[id, value] : results.von_mises_max)
+        out << "  max von Mises [Pa] in " << std::left << std::setw(14)
+            << materials[id].name << std::right << " " << shown_stress(value)
+            << "\n";
+    for (const auto &i : results.interfaces)
+      out << "  contact '" << i.name << "': " << i.n_active << " of "
+          << i.n_pairs << " pairs active, force [N/m] " << i.force
+          << ", peak pressure [Pa] " << i.max_pressure
+          << ", contact length [m] " << i.contact_length << "\n";
+    if (!contact_pairs.empty())
+      out << "  active-set iterations " << contact_solution.n_iterations
+          << (contact_solution.converged ? ", converged" : ", NOT converged")
+          << "\n";
+    if (output_writer.test_mode())
+      for (unsigned int p = 0; p < contact_pairs.size(); ++p)
+        if (contact_solution.active[p])
+          out << "  pair at "
+              << list(contact_pairs.points[p].position,
+                      [](const double x) { return x; })
+              << " pressure [Pa] " << results.pressure[p] << "\n";
+    out << std::defaultfloat << std::flush;
+  }
+
+
+
+#define KNEE_CONTACT_INSTANTIATE(dim)                                         \
+  template void ContactProblem<dim>::write_result_set(                        \
+    const Results<dim> &,                                                     \
+    const std::vector<std::vector<CycleRecord>> &,                            \
+    TimerOutput &);                                                           \
+  template unsigned int ContactProblem<dim>::run_load_cases(                  \
+    const Results<dim> &,                                                     \
+    const std::vector<std::vector<CycleRecord>> &,                            \
+    TimerOutput &);                                                           \
+  template void ContactProblem<dim>::print_results(const Results<dim> &) const;
+  KNEE_CONTACT_INSTANTIATE(2)
+  KNEE_CONTACT_INSTANTIATE(3)
+#undef KNEE_CONTACT_INSTANTIATE
+} // namespace knee_contact

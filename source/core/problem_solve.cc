@@ -1,0 +1,258 @@
+// The cycles of a run: mesh, setup, assembly, contact solve and errors per
+// refinement cycle (ContactProblem's orchestration, split from problem.cc
+// by job as ASPECT splits its Simulator).
+#include <knee_contact/core/problem.h>
+#include <knee_contact/physics/elasticity.h>
+#include <knee_contact/physics/rigid_modes.h>
+#include <knee_contact/mesh/scene_checks.h>
+
+#include <deal.II/base/timer.h>
+#include <deal.II/base/utilities.h>
+
+#include <deal.II/lac/sparse_direct.h>
+
+#include <cmath>
+#include <functional>
+#include <iomanip>
+#include <iostream>
+#include <new>
+
+namespace knee_contact
+{
+  template <int dim>
+  std::vector<CycleRecord>
+  ContactProblem<dim>::run_cycles(const Refinement::Strategy strategy,
+                             TimerOutput               &timer,
+                             Results<dim>              &results)
+  {
+    std::vector<CycleRecord> records;
+    const unsigned int       n_cycles = strategy == Refinement::Strategy::global
+                                          ? refinement.n_cycles
+                                          : refinement.n_adaptive_cycles;
+    for (unsigned int cycle = 0; cycle < n_cycles; ++cycle)
+      {
+        CycleRecord record;
+        record.strategy = Refinement::name(strategy);
+        record.cycle    = cycle;
+        // Each phase goes to the run's TimerOutput and to this cycle's row.
+        const auto timed = [&](const std::string           &phase,
+                               const std::function<void()> &work) {
+          TimerOutput::Scope scope(timer, phase);
+          Timer              clock;
+          work();
+          record.wall_time[phase] += clock.wall_time();
+        };
+
+        timed("mesh", [&]() {
+          if (cycle == 0)
+            make_mesh(0);
+          else if (strategy == Refinement::Strategy::global &&
+                   mesh_input.remeshes(triangulation))
+            make_mesh(cycle);
+          else
+            {
+              refinement.refine(strategy,
+                                triangulation,
+                                dof_handler,
+                                displacement,
+                                materials,
+                                contact_interfaces,
+                                contact_pairs,
+                                contact_solution);
+              check_cells(triangulation);
+            }
+          scene_checks::check_finite_data(triangulation,
+                                          materials,
+                                          boundary_conditions);
+        });
+        timed("setup", [&]() { setup_system(); });
+        std::cout << record.strategy << " cycle " << cycle << ": "
+                  << triangulation.n_active_cells() << " cells, "
+                  << dof_handler.n_dofs() << " dofs, " << n_bodies
+                  << " bodies, " << contact_pairs.size() << " contact pairs"
+                  << std::endl;
+        timed("assembly", [&]() {
+          ElasticityAssembler<dim> assembler(materials, boundary_conditions);
+          assembler.assemble(dof_handler, system_matrix, system_rhs);
+        });
+        timed("solve", [&]() {
+          // Warm start on a refined mesh: pairs within the previous contact
+          // zone start active (the loop corrects the guess).
+          std::vector<bool> guess;
+          if (cycle > 0)
+            {
+              guess.assign(contact_pairs.size(), false);
+              for (unsigned int p = 0; p < contact_pairs.size(); ++p)
+                for (const auto &[position, length] : previous_contact)
+                  if (contact_pairs.points[p].position.distance(position) <=
+                      length)
+                    guess[p] = true;
+            }
+          solve_contact(guess, true);
+        });
+        timed("postprocess", [&]() {
+          results       = current_results();
+          record.errors = verification.compute_errors(
+            dof_handler, displacement, materials, contact_pairs, results);
+        });
+
+        previous_contact.clear();
+        for (unsigned int p = 0; p < contact_pairs.size(); ++p)
+          if (contact_solution.active[p])
+            previous_contact.emplace_back(
+              contact_pairs.points[p].position,
+              std::pow(contact_pairs.rows[p].length, 1. / (dim - 1)));
+        record.n_cells        = triangulation.n_active_cells();
+        record.n_dofs         = dof_handler.n_dofs();
+        record.n_pairs        = contact_pairs.size();
+        record.n_iterations   = contact_solution.n_iterations;
+        record.solver         = solver_name;
+        record.solver_figures = solver_figures;
+        record.energy         = results.energy;
+        for (const auto &i : results.interfaces)
+          record.peak_pressure = std::max(record.peak_pressure, i.max_pressure);
+        for (const auto &phase : record.wall_time)
+          record.total_time += phase.second;
+        if (!output_writer.test_mode())
+          std::cout << std::setprecision(7) << "   " << record.n_dofs
+                    << " dofs: peak pressure " << record.peak_pressure
+                    << ", energy " << record.energy << ", " << record.total_time
+                    << " s" << std::endl;
+        Utilities::System::MemoryStats memory;
+        Utilities::System::get_memory_stats(memory);
+        record.peak_memory = memory.VmHWM / 1024.;
+        records.push_back(record);
+        if (!contact_solution.converged)
+          break;
+      }
+    return records;
+  }
+
+
+
+  template <int dim>
+  void
+  ContactProblem<dim>::solve_contact(const std::vector<bool> &guess,
+                                const bool               new_matrix)
+  {
+    const RigidModes<dim> rigid_modes(dof_handler, body_of_cell, body_names);
+    std::ostream    &loop_log = contact_pairs.empty() ? quiet : std::cout;
+    try
+      {
+        Timer clock;
+        if (new_matrix)
+          {
+            solver_figures.clear();
+            contact_system.reset();
+            contact_system =
+              make_contact_system(active_set_solver.linear_solver(),
+                                  system_matrix,
+                                  constraints,
+                                  contact_pairs.rows,
+                                  !guess.empty(),
+                                  output_writer.test_mode() ? quiet : loop_log,
+                                  solver_name,
+                                  solver_figures);
+          }
+        contact_system->set_rhs(system_rhs);
+        contact_solution = active_set_solver.solve(*contact_system,
+                                                   system_rhs.linfty_norm(),
+                                                   constraints,
+                                                   contact_pairs.rows,
+                                                   rigid_modes,
+                                                   guess,
+                                                   loop_log);
+        contact_system->solution(displacement);
+        solver_figures["contact_solve"] = clock.wall_time();
+        for (const auto &[name, value] : contact_system->statistics())
+          solver_figures[name] = value;
+        if (new_matrix && active_set_solver.measure_reference())
+          {
+            Vector<double> x;
+            solver_figures["reference_solve"] =
+              reference_solve(system_matrix,
+                              system_rhs,
+                              constraints,
+                              contact_pairs.rows,
+                              contact_solution.active,
+                              x);
+            x -= displacement;
+            solver_figures["reference_difference"] =
+              x.linfty_norm() / std::max(displacement.linfty_norm(), 1e-300);
+          }
+      }
+    catch (const ContactSystem::ExcNotPositiveDefinite &)
+      {
+        AssertThrow(false,
+                    ExcMessage("the stiffness matrix is singular "
+                               "under the active contact rows; check "
+                               "that every body is held"));
+      }
+    catch (const SparseDirectUMFPACK::ExcUMFPACKError &exc)
+      {
+        // UMFPACK's status: 1 singular, -1 out of memory.
+        std::ostringstream info;
+        exc.print_info(info);
+        const bool memory = info.str().find("status -1") != std::string::npos;
+        if (memory)
+          throw std::bad_alloc();
+        AssertThrow(false,
+                    ExcMessage("UMFPACK: the stiffness matrix is "
+                               "singular; check that every body is "
+                               "held"));
+      }
+    // Finite data and moduli were checked; a non-finite solution
+    // means they are too extreme together for double precision.
+    for (const double u : displacement)
+      AssertThrow(std::isfinite(u),
+                  ExcMessage("the solution is not finite: the loads and "
+                             "displacements are too large for the moduli "
+                             "(E from " +
+                             std::to_string(materials.min_youngs_modulus()) +
+                             " to " +
+                             std::to_string(materials.max_youngs_modulus()) +
+                             " Pa); choose units that keep them near 1"));
+  }
+
+
+
+  template <int dim>
+  Results<dim>
+  ContactProblem<dim>::current_results() const
+  {
+    return compute_results(dof_handler,
+                           body_of_cell,
+                           system_matrix,
+                           system_rhs,
+                           displacement,
+                           materials,
+                           boundary_conditions,
+                           contact_interfaces,
+                           contact_pairs,
+                           contact_solution);
+  }
+
+
+
+  template <int dim>
+  void
+  ContactProblem<dim>::set_load_parameter(const double t)
+  {
+    materials.set_load_parameter(t);
+    boundary_conditions.set_load_parameter(t);
+    verification.set_load_parameter(t);
+  }
+
+
+
+#define KNEE_CONTACT_INSTANTIATE(dim)                                        \
+  template std::vector<CycleRecord> ContactProblem<dim>::run_cycles(         \
+    const Refinement::Strategy, TimerOutput &, Results<dim> &);              \
+  template void ContactProblem<dim>::solve_contact(const std::vector<bool> &, \
+                                                   const bool);              \
+  template Results<dim> ContactProblem<dim>::current_results() const;        \
+  template void         ContactProblem<dim>::set_load_parameter(const double);
+  KNEE_CONTACT_INSTANTIATE(2)
+  KNEE_CONTACT_INSTANTIATE(3)
+#undef KNEE_CONTACT_INSTANTIATE
+} // namespace knee_contact

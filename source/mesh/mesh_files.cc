@@ -1,0 +1,430 @@
+#include <knee_contact/mesh/gmsh_input.h>
+#include <knee_contact/core/input.h>
+#include <knee_contact/core/interruption.h>
+#include <knee_contact/mesh/mesh.h>
+#include <knee_contact/mesh/mesh_readers.h>
+
+#include <deal.II/grid/grid_in.h>
+#include <deal.II/grid/grid_tools.h>
+#include <deal.II/grid/manifold_lib.h>
+
+#include <iomanip>
+#include <memory>
+#include <sstream>
+
+#include <array>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <numeric>
+#include <tuple>
+
+
+// MeshInput's members that read mesh files (Gmsh, and in 2D Abaqus, VTK,
+// VTU, UCD), make the built-in rectangles and build the triangulation of a
+// description; scene_dimension(), which reads the Gmsh file first.
+namespace knee_contact
+{
+  namespace
+  {
+    /**
+     * A .msh ready to read: the user's file, or the mesh gmsh made of a .geo
+     * in a private temporary folder (removed on Ctrl-C too, and when this
+     * goes), checked by check_msh, with the dimension of its cells.
+     */
+    struct CheckedMsh
+    {
+      std::string              file;
+      std::vector<std::string> arguments;
+      std::string              msh;
+      std::string              folder;
+      unsigned int             dim = 0;
+
+      ~CheckedMsh()
+      {
+        if (!folder.empty())
+          {
+            interruption::unregister_folder(folder);
+            std::error_code ignored;
+            std::filesystem::remove_all(folder, ignored);
+          }
+      }
+    };
+
+    /**
+     * The mesh scene_dimension() checked, kept for MeshInput::read_gmsh()
+     * so that a .geo is meshed once per run.
+     */
+    std::unique_ptr<CheckedMsh> kept_msh;
+
+    std::unique_ptr<CheckedMsh>
+    checked_msh(const std::string              &file,
+                const std::vector<std::string> &arguments,
+                const double                    time_limit)
+    {
+      if (kept_msh && kept_msh->file == file &&
+          kept_msh->arguments == arguments)
+        return std::move(kept_msh);
+      auto result       = std::make_unique<CheckedMsh>();
+      result->file      = file;
+      result->arguments = arguments;
+      result->msh       = file;
+      if (std::filesystem::path(file).extension() == ".geo")
+        {
+          std::string folder =
+            (std::filesystem::temp_directory_path() / "knee_contact_XXXXXX")
+              .string();
+          AssertThrow(mkdtemp(folder.data()) != nullptr,
+                      ExcMessage("cannot create a temporary folder for gmsh"));
+          interruption::register_folder(folder);
+          result->folder = folder;
+          result->msh    = folder + "/mesh.msh";
+          gmsh_input::mesh(file, result->msh, arguments, time_limit);
+        }
+      // deal.II's reader trusts its input; check the file first.
+      try
+        {
+          result->dim = gmsh_input::check_msh(result->msh);
+        }
+      catch (const std::exception &exc)
+        {
+          // Name the user's .geo, not the temporary file.
+          std::string message = exc.what();
+          const auto  at      = message.find("'" + result->msh + "'");
+          if (result->msh != file && at != std::string::npos)
+            message.replace(at,
+                            result->msh.size() + 2,
+                            "the mesh gmsh made of '" + file + "',");
+          AssertThrow(false, ExcMessage(message));
+        }
+      return result;
+    }
+  } // namespace
+
+
+
+  unsigned int
+  scene_dimension(ParameterHandler &prm, const std::string &scene_file)
+  {
+    prm.enter_subsection("Mesh");
+    const bool        from_file = prm.get("Source") == "file";
+    const std::string file = input::resolve_path(prm.get("File"), scene_file);
+    const auto arguments   = gmsh_input::arguments(prm.get("Gmsh arguments"));
+    const double time_limit = prm.get_double("Gmsh time limit");
+    prm.leave_subsection();
+    const auto extension = std::filesystem::path(file).extension();
+    // Anything else is 2D; a missing file is reported by MeshInput.
+    if (!from_file || (extension != ".msh" && extension != ".geo") ||
+        !std::filesystem::is_regular_file(file) || !std::ifstream(file).good())
+      return 2;
+    kept_msh = checked_msh(file, arguments, time_limit);
+    return kept_msh->dim;
+  }
+
+
+
+  template <int dim>
+  mesh_readers::Description<dim>
+  MeshInput<dim>::read_gmsh(const unsigned int level) const
+  {
+    // Level L: the mesh size times 2^-L (gmsh's -clscale, on top of one the
+    // scene gives).
+    std::vector<std::string> arguments = gmsh_arguments;
+    if (level > 0)
+      {
+        const double factor = std::pow(0.5, level);
+        const auto   it = std::find(arguments.begin(), arguments.end(), "-clscale");
+        std::ostringstream scale;
+        scale << std::setprecision(17)
+              << factor * (it != arguments.end() && it + 1 != arguments.end()
+                             ? input::number(*(it + 1)).value_or(1.)
+                             : 1.);
+        if (it != arguments.end() && it + 1 != arguments.end())
+          *(it + 1) = scale.str();
+        else
+          arguments.insert(arguments.end(), {"-clscale", scale.str()});
+      }
+    auto msh = checked_msh(file, arguments, gmsh_time_limit);
+    AssertThrow(msh->dim == dim, ExcInternalError());
+    Triangulation<dim> read;
+    GridIn<dim>        grid_in;
+    grid_in.attach_triangulation(read);
+    std::ifstream in(msh->msh);
+    try
+      {
+        grid_in.read_msh(in);
+      }
+    catch (const std::exception &exc)
+      {
+        AssertThrow(false,
+                    ExcMessage("Mesh/File: cannot read '" + file +
+                               "' as a Gmsh mesh (" +
+                               input::one_line(exc.what()) + ")"));
+      }
+    msh.reset();
+    mesh_readers::Description<dim> mesh;
+    std::tie(mesh.vertices, mesh.cells, mesh.subcells) =
+      GridTools::get_coarse_mesh_description(read);
+    return mesh;
+  }
+
+
+
+  template <int dim>
+  mesh_readers::Description<2>
+  MeshInput<dim>::read_vtk() const
+  {
+    mesh_readers::check_vtk(file);
+    Triangulation<2> read;
+    GridIn<2>        grid_in;
+    grid_in.attach_triangulation(read);
+    std::ifstream in(file);
+    try
+      {
+        grid_in.read_vtk(in);
+      }
+    catch (const std::exception &exc)
+      {
+        AssertThrow(false,
+                    ExcMessage("Mesh/File: cannot read '" + file +
+                               "' as a VTK mesh (" +
+                               input::one_line(exc.what()) + ")"));
+      }
+    mesh_readers::Description<2> mesh;
+    std::tie(mesh.vertices, mesh.cells, mesh.subcells) =
+      GridTools::get_coarse_mesh_description(read);
+    return mesh;
+  }
+
+
+
+  template <int dim>
+  void
+  MeshInput<dim>::read_file(Triangulation<dim> &triangulation,
+                            const unsigned int  level) const
+  {
+    const std::string extension = std::filesystem::path(file).extension();
+    AssertThrow(extension == ".inp" ||
+                  (abaqus_element_sets.empty() && abaqus_boundary_sets.empty()),
+                ExcMessage("Mesh/Abaqus element sets and Abaqus boundary sets "
+                           "are for .inp files, not '" +
+                           file + "'"));
+    mesh_readers::Description<dim> mesh;
+    if (extension == ".msh" || extension == ".geo")
+      mesh = read_gmsh(level);
+    else if constexpr (dim == 3)
+      {
+        // scene_dimension() gives 3 for Gmsh files only.
+        AssertThrow(false, ExcInternalError());
+      }
+    else
+      {
+        if (extension == ".inp")
+          mesh = mesh_readers::read_abaqus(file,
+                                           abaqus_element_sets,
+                                           abaqus_boundary_sets);
+        else if (extension == ".vtk")
+          mesh = read_vtk();
+        else if (extension == ".vtu")
+          mesh = mesh_readers::read_vtu(file);
+        else if (extension == ".ucd")
+          mesh = mesh_readers::read_ucd(file);
+        else
+          AssertThrow(false,
+                      ExcMessage("Mesh/File: '" + file +
+                                 "' has an extension knee_contact does not "
+                                 "read (.msh, .geo, .inp, .vtk, .vtu, .ucd)"));
+      }
+
+    // Cells turned the wrong way round (Gmsh keeps the orientation of a
+    // clockwise curve loop, other tools list clockwise cells) are turned
+    // over; check_cells() refuses what is still inverted or degenerate.
+    try
+      {
+        GridTools::invert_cells_with_negative_measure(mesh.vertices,
+                                                      mesh.cells);
+      }
+    catch (const std::exception &)
+      {
+        AssertThrow(false,
+                    ExcMessage("Mesh/File: '" + file +
+                               "' has a cell that is degenerate or not "
+                               "convex"));
+      }
+
+    finish(mesh, triangulation);
+  }
+
+
+
+  template <int dim>
+  void
+  MeshInput<dim>::finish(mesh_readers::Description<dim> &mesh,
+                         Triangulation<dim>             &triangulation) const
+  {
+    bool simplices = false, others = false;
+    for (const auto &cell : mesh.cells)
+      (cell.vertices.size() == dim + 1 ? simplices : others) = true;
+    if constexpr (dim == 2)
+      {
+        if (simplices && (others || split_triangles || adaptive))
+          mesh_readers::split_into_quadrilaterals(mesh, circular_boundaries);
+      }
+    else
+      AssertThrow(!simplices || !adaptive,
+                  ExcMessage("Refinement/Strategy: a tetrahedral mesh cannot "
+                             "be refined adaptively (deal.II 9.4 has no "
+                             "hanging nodes on simplices); use global "
+                             "refinement or a hexahedral mesh"));
+    try
+      {
+        triangulation.create_triangulation(mesh.vertices,
+                                           mesh.cells,
+                                           mesh.subcells);
+      }
+    catch (const std::exception &exc)
+      {
+        AssertThrow(false,
+                    ExcMessage((source == Source::file
+                                  ? "Mesh/File: '" + file + "'"
+                                  : std::string("Mesh/Rectangles: the mesh")) +
+                               " is not a valid mesh (" +
+                               input::one_line(exc.what()) + ")"));
+      }
+  }
+
+
+
+  template <int dim>
+  void
+  MeshInput<dim>::make_rectangles(Triangulation<dim> &triangulation) const
+  {
+    if constexpr (dim != 2)
+      {
+        // scene_dimension() gives 2 for Source = rectangles.
+        (void)triangulation;
+        AssertThrow(false, ExcInternalError());
+      }
+    else
+      make_rectangles_2d(triangulation);
+  }
+
+
+
+  template <int dim>
+  void
+  MeshInput<dim>::make_rectangles_2d(Triangulation<2> &triangulation) const
+  {
+    // Vertices are shared within a group of rectangles (bonded) and never
+    // between groups (contact), which GridGenerator::merge_triangulations
+    // cannot express; so the cells are listed here directly.
+    mesh_readers::Description<2> mesh;
+    std::vector<Point<2>>       &vertices = mesh.vertices;
+    std::map<std::pair<unsigned int, std::pair<long, long>>, unsigned int>
+           vertex_index;
+    double h = std::numeric_limits<double>::max();
+    for (const Rectangle &rect : rectangles)
+      h = std::min({h,
+                    (rect.upper[0] - rect.lower[0]) / rect.n_x,
+                    (rect.upper[1] - rect.lower[1]) / rect.n_y});
+    // Coincident vertices are found by coordinates rounded far below the
+    // smallest cell size.
+    const double scale = 1e6 / h;
+    for (unsigned int r = 0; r < rectangles.size(); ++r)
+      {
+        const Rectangle          &rect = rectangles[r];
+        std::vector<unsigned int> index((rect.n_x + 1) * (rect.n_y + 1));
+        for (unsigned int j = 0; j <= rect.n_y; ++j)
+          for (unsigned int i = 0; i <= rect.n_x; ++i)
+            {
+              const Point<2> p(rect.lower[0] +
+                                 (rect.upper[0] - rect.lower[0]) * i / rect.n_x,
+                               rect.lower[1] + (rect.upper[1] - rect.lower[1]) *
+                                                 j / rect.n_y);
+              const auto     key =
+                std::make_pair(rect.group,
+                               std::make_pair(std::lround(p[0] * scale),
+                                              std::lround(p[1] * scale)));
+              const auto it = vertex_index.find(key);
+              if (it != vertex_index.end())
+                index[j * (rect.n_x + 1) + i] = it->second;
+              else
+                {
+                  vertex_index[key]             = vertices.size();
+                  index[j * (rect.n_x + 1) + i] = vertices.size();
+                  vertices.push_back(p);
+                }
+            }
+        for (unsigned int j = 0; j < rect.n_y; ++j)
+          for (unsigned int i = 0; i < rect.n_x; ++i)
+            {
+              const unsigned int a = index[j * (rect.n_x + 1) + i],
+                                 b = index[j * (rect.n_x + 1) + i + 1],
+                                 c = index[(j + 1) * (rect.n_x + 1) + i],
+                                 d = index[(j + 1) * (rect.n_x + 1) + i + 1];
+              const bool split =
+                rectangle_cells == RectangleCells::triangles ||
+                (rectangle_cells == RectangleCells::mixed && (i + j) % 2 == 1);
+              // Two counter-clockwise triangles cut along the diagonal a-d,
+              // or one quadrilateral.
+              for (const auto &corners :
+                   split ? std::vector<std::vector<unsigned int>>{{a, b, d},
+                                                                  {a, d, c}}
+                         : std::vector<std::vector<unsigned int>>{{a, b, c, d}})
+                {
+                  CellData<2> cell(corners.size());
+                  cell.vertices    = corners;
+                  cell.material_id = rect.material_id;
+                  mesh.cells.push_back(cell);
+                }
+            }
+      }
+    if constexpr (dim == 2)
+      finish(mesh, triangulation);
+
+    // Boundary ids by the side of the cell's rectangle each boundary face
+    // lies on.
+    for (const auto &cell : triangulation.active_cell_iterators())
+      {
+        const Point<2> centre = cell->center();
+        const auto     rect   = *std::find_if(
+          rectangles.begin(), rectangles.end(), [&](const Rectangle &r) {
+            return r.material_id == cell->material_id() &&
+                   centre[0] > r.lower[0] && centre[0] < r.upper[0] &&
+                   centre[1] > r.lower[1] && centre[1] < r.upper[1];
+          });
+        const double tol = 1e-8 * cell->diameter();
+        for (const unsigned int f : cell->face_indices())
+          if (cell->face(f)->at_boundary())
+            {
+              const Point<2> c = cell->face(f)->center();
+              if (std::abs(c[0] - rect.lower[0]) < tol)
+                cell->face(f)->set_boundary_id(rect.boundary_ids[0]);
+              else if (std::abs(c[0] - rect.upper[0]) < tol)
+                cell->face(f)->set_boundary_id(rect.boundary_ids[1]);
+              else if (std::abs(c[1] - rect.lower[1]) < tol)
+                cell->face(f)->set_boundary_id(rect.boundary_ids[2]);
+              else
+                cell->face(f)->set_boundary_id(rect.boundary_ids[3]);
+            }
+      }
+  }
+
+
+
+#define KNEE_CONTACT_INSTANTIATE(dim)                                        \
+  template mesh_readers::Description<dim> MeshInput<dim>::read_gmsh(        \
+    const unsigned int) const;                                               \
+  template mesh_readers::Description<2> MeshInput<dim>::read_vtk() const;    \
+  template void MeshInput<dim>::read_file(Triangulation<dim> &,              \
+                                          const unsigned int) const;         \
+  template void MeshInput<dim>::finish(mesh_readers::Description<dim> &,     \
+                                       Triangulation<dim> &) const;          \
+  template void MeshInput<dim>::make_rectangles(Triangulation<dim> &) const; \
+  template void MeshInput<dim>::make_rectangles_2d(Triangulation<2> &) const;
+  KNEE_CONTACT_INSTANTIATE(2)
+  KNEE_CONTACT_INSTANTIATE(3)
+#undef KNEE_CONTACT_INSTANTIATE
+} // namespace knee_contact
