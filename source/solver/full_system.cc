@@ -1,6 +1,6 @@
 // The step-41 path of the solver seam: the whole system condensed by
 // AffineConstraints and factorised by UMFPACK for each active set; the
-// reference the other paths are tested against (tests/solver_paths.cc).
+// reference the other paths are tested against (tests/unit/solver_paths.cc).
 #include <knee_contact/solver/active_set.h>
 #include <knee_contact/solver/contact_system.h>
 

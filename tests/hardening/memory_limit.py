@@ -96,7 +96,7 @@ end
     same = False
     if code == 0 and limited is not None:
         energy = (free.get("energy"), limited.get("energy"))
-        # The tolerance of tests/solver_paths.cc for a Young's modulus
+        # The tolerance of tests/unit/solver_paths.cc for a Young's modulus
         # contrast r: 1e-12 r (r = 4e11 / 3.4e8 = 1 176 here).
         same = (energy[0] is not None and
                 abs(energy[0] - energy[1]) <= 1.2e-9 * abs(energy[0]))

@@ -17,7 +17,7 @@ trap 'kill $(jobs -p) 2>/dev/null; rm -rf "$work"' EXIT
 cd "$work"
 # The folder name holds a space, an apostrophe, a $ and a ';': data only.
 folder="out put's \$x;y"
-sed -e "s|^  set Folder .*||" -e "s|= \.\./prm/|= $(dirname "$scene")/../prm/|" \
+sed -e "s|^  set Folder .*||" -e "s|= \(\.\./\)*prm/|= $(cd "$(dirname "$0")/../../prm" && pwd)/|" \
   -e 's/^  set Write files .*//' -e 's/^  set Terminal .*//' "$scene" >scene.prm
 printf 'subsection Output\n  set Folder = %s\n  set Pictures = true\nend\n' \
   "$folder" >>scene.prm

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Hertz on triangles (P1) against quadrilaterals (Q1) at comparable DoFs.
 
-tests/hertz_small.prm (cylinder on a block, as there) is
+tests/scenes/hertz_small.prm (cylinder on a block, as there) is
 run as it is (Gmsh quadrilaterals, Q1) and with -setnumber triangles 1 on a
 finer lc_fine chosen so that the P1 mesh has about as many DoFs (asserted:
 within a factor 1.5). Asserted: the P1 peak pressure is within 1 % of the
@@ -18,13 +18,13 @@ import sys
 import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-GEO = os.path.abspath(os.path.join(HERE, "..", "prm", "hertz.geo"))
+GEO = os.path.abspath(os.path.join(HERE, "..", "..", "prm", "hertz.geo"))
 TOLERANCE = 0.01
 
 
 def run(binary, folder, name, arguments):
-    text = open(os.path.join(HERE, "hertz_small.prm")).read()
-    text = text.replace("../prm/hertz.geo", GEO)
+    text = open(os.path.join(HERE, "..", "scenes", "hertz_small.prm")).read()
+    text = text.replace("../../prm/hertz.geo", GEO)
     text = re.sub(r"set Gmsh arguments *=.*", "set Gmsh arguments = " +
                   arguments, text)
     text = text[:text.index("subsection Verification")]

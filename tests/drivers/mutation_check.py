@@ -66,7 +66,7 @@ EXEMPT = [
      "E x 1.01, the same factor the other way, is killed"),
     ("sliding_rotated_square.prm", r"^geometry:",
      "homogeneous strain: u = eps x on a square of any size"),
-    # Measured sensitivities (tests/knee_small.prm, knee_frontal_small.prm:
+    # Measured sensitivities (tests/scenes/knee_small.prm, knee_frontal_small.prm:
     # relative change of a(u,u) / of the peak pressures under x 1.01):
     # bone nu 1.9e-4 / 2.8e-4; Ti6Al4V E 8.1e-5 / 7.0e-5, nu 1.9e-5 /
     # 2.2e-5; ZrO2 E 4.0e-5 / 2.9e-5, nu 5.7e-6 / 3.6e-6; peak pressures

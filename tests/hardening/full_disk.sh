@@ -19,7 +19,7 @@ cd "$work"
 fail() { echo "FAIL: $*"; exit 1; }
 for s in small big; do
   scene=${!s}
-  sed -e "s|^  set Folder .*||" -e "s|= \.\./prm/|= $(dirname "$scene")/../prm/|" \
+  sed -e "s|^  set Folder .*||" -e "s|= \(\.\./\)*prm/|= $(cd "$(dirname "$0")/../../prm" && pwd)/|" \
     -e 's/^  set Write files .*//' -e 's/^  set Pictures .*//' "$scene" >$s.prm
   printf 'subsection Output\n  set Folder = disk/out\n  set Pictures = false\nend\n' >>$s.prm
 done

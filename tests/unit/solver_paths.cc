@@ -140,27 +140,27 @@ namespace
 int
 main()
 {
-  const char *scenes[] = {"contact_patch_matching.prm",
-                          "contact_patch_nonmatching.prm",
-                          "contact_separation.prm",
-                          "sliding_rotated_square.prm",
-                          "hertz_small.prm",
-                          "hertz_study_small.prm",
-                          "knee_small.prm",
-                          "knee_frontal_small.prm",
+  const char *scenes[] = {"../scenes/contact_patch_matching.prm",
+                          "../scenes/contact_patch_nonmatching.prm",
+                          "../scenes/contact_separation.prm",
+                          "../scenes/sliding_rotated_square.prm",
+                          "../scenes/hertz_small.prm",
+                          "../scenes/hertz_study_small.prm",
+                          "../scenes/knee_small.prm",
+                          "../scenes/knee_frontal_small.prm",
                           "qp_scene.prm",
                           "qp_scene_mortar.prm",
-                          "../prm/hard/floating_pressed.prm",
-                          "../prm/hard/rigid_sliding.prm",
-                          "../prm/hard/active_set_cycle.prm",
-                          "../prm/hard/active_set_cycle_unsafeguarded.prm",
-                          "../prm/hard/partial_closure.prm",
-                          "../prm/hard/contrast_1e6.prm",
-                          "../prm/hard/incompressible.prm",
-                          "../prm/hard/large_gap.prm",
-                          "../prm/hard/many_pairs.prm",
-                          "../prm/hard/thin_layer.prm",
-                          "../prm/hard/zero_load.prm"};
+                          "../../prm/hard/floating_pressed.prm",
+                          "../../prm/hard/rigid_sliding.prm",
+                          "../../prm/hard/active_set_cycle.prm",
+                          "../../prm/hard/active_set_cycle_unsafeguarded.prm",
+                          "../../prm/hard/partial_closure.prm",
+                          "../../prm/hard/contrast_1e6.prm",
+                          "../../prm/hard/incompressible.prm",
+                          "../../prm/hard/large_gap.prm",
+                          "../../prm/hard/many_pairs.prm",
+                          "../../prm/hard/thin_layer.prm",
+                          "../../prm/hard/zero_load.prm"};
   bool        all      = true;
   for (const std::string scene : scenes)
     all = compare(scene) && all;

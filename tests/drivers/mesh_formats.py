@@ -10,7 +10,7 @@ with line elements for the sides), as a legacy VTK file and as
 VTK XML .vtu files in the four encodings VTK and ParaView write (ascii,
 base64, base64 of zlib blocks, raw appended; MaterialID of cells and of
 boundary lines), and as an AVS UCD file. The scene is the contact patch
-test of tests/contact_patch_matching.prm (stiff block pressed on a soft one,
+test of tests/scenes/contact_patch_matching.prm (stiff block pressed on a soft one,
 sides sliding, node pairs on the matching interface).
 
 Asserted, per mesh (triangles, mixed):
@@ -34,7 +34,7 @@ import tempfile
 import zlib
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-GEO = os.path.join(HERE, "meshes", "patch_stack.geo")
+GEO = os.path.join(HERE, "..", "meshes", "patch_stack.geo")
 TOLERANCE = 1e-12
 
 SCENE = """
@@ -124,7 +124,7 @@ def write_inp(path, nodes, cells, lines):
     """Abaqus deck: bodies as element sets BODY_1, BODY_2 (also given in
     *Element lines by type), outer sides as node sets, contact sides as
     element-face surfaces."""
-    out = ["*Heading", "** written by tests/mesh_formats.py", "*Node"]
+    out = ["*Heading", "** written by tests/drivers/mesh_formats.py", "*Node"]
     out += ["%d, %.17g, %.17g" % (t, x, y) for t, (x, y) in nodes.items()]
     for n, kind in ((3, "CPE3"), (4, "CPE4R")):
         numbered = [(e + 1, c) for e, c in enumerate(cells)
@@ -177,7 +177,7 @@ def write_vtk(path, nodes, cells, lines):
 def write_ucd(path, nodes, cells, lines):
     """AVS UCD: counts, nodes, then tri/quad cells (material) and line
     cells (boundary id)."""
-    out = ["# written by tests/mesh_formats.py",
+    out = ["# written by tests/drivers/mesh_formats.py",
            "%d %d 0 0 0" % (len(nodes), len(cells) + len(lines))]
     out += ["%d %.17g %.17g 0" % (t, x, y) for t, (x, y) in nodes.items()]
     kinds = {2: "line", 3: "tri", 4: "quad"}

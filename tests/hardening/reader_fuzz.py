@@ -24,6 +24,8 @@ import tempfile
 # Import the sibling scripts without leaving __pycache__ in the source tree.
 sys.dont_write_bytecode = True
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                                "..", "drivers"))
 import fuzz  # noqa: E402
 import mesh_formats  # noqa: E402
 

@@ -22,8 +22,8 @@ import sys
 import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-SCENE = os.path.join(HERE, "..", "prm", "knee_gait.prm")
-GEO = os.path.abspath(os.path.join(HERE, "..", "prm", "knee.geo"))
+SCENE = os.path.join(HERE, "..", "..", "prm", "knee_gait.prm")
+GEO = os.path.abspath(os.path.join(HERE, "..", "..", "prm", "knee.geo"))
 VALUES = [0, 0.15, 0.3, 0.45, 0.6, 0.8]
 TOLERANCE = 1e-10
 

@@ -13,7 +13,7 @@ trap 'rm -rf "$work"' EXIT
 cmake --install "$build" --prefix "$work/prefix" >"$work/install.log" 2>&1 ||
   { cat "$work/install.log"; echo "FAIL: cmake --install"; exit 1; }
 sed -e "s|^  set Folder .*||" -e 's/^  set Write files .*//' -e 's/^  set Pictures .*//' \
-  -e "s|= \.\./prm/|= $(cd "$(dirname "$scene")/../prm" && pwd)/|" "$scene" >"$work/scene.prm"
+  -e "s|= \(\.\./\)*prm/|= $(cd "$(dirname "$0")/../../prm" && pwd)/|" "$scene" >"$work/scene.prm"
 printf 'subsection Output\n  set Folder = out\n  set Pictures = true\nend\n' >>"$work/scene.prm"
 cd "$work"
 "$work/prefix/bin/knee_contact" scene.prm >run.log 2>&1 || { tail -n 3 run.log; echo "FAIL: run"; exit 1; }

@@ -12,7 +12,7 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 for run in a b c; do
   sed -e 's/^  set Write files = false/  set Write files = true\n  set Pictures    = false\n  set Folder      = '"$run"'/' \
-      -e "s|= \.\./prm/|= $(dirname "$scene")/../prm/|" "$scene" >"$work/$run.prm"
+      -e "s|= \(\.\./\)*prm/|= $(cd "$(dirname "$0")/../../prm" && pwd)/|" "$scene" >"$work/$run.prm"
   threads=2
   [ $run = c ] && threads=1
   (cd "$work" && DEAL_II_NUM_THREADS=$threads "$program" "$run.prm" >/dev/null) ||
