@@ -23,6 +23,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from plot_results import save  # noqa: E402
+
 
 def main(folder):
     with open(os.path.join(folder, "summary.json")) as f:
@@ -54,11 +57,7 @@ def main(folder):
     figure.colorbar(mappable, ax=figure.axes, shrink=0.6,
                     label="von Mises stress [MPa]")
     figure.suptitle("deformed surface (displacement x %g)" % magnification)
-    path = os.path.join(folder, "von_mises.png")
-    temporary = path + ".part.png"
-    figure.savefig(temporary, dpi=120, bbox_inches="tight")
-    plt.close(figure)
-    os.replace(temporary, path)
+    save(figure, os.path.join(folder, "von_mises.png"))
 
 
 if __name__ == "__main__":

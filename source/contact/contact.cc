@@ -376,7 +376,7 @@ namespace knee_contact
 
         for (unsigned int p = 0; p < rows.size(); ++p)
           {
-            ContactRow &pair = rows.rows[p];
+            ContactRow &pair       = rows.rows[p];
             const auto &slave_dofs = rows.points[p].slave_dofs;
             reduce_row(pair, constraints);
             // Eliminate the free slave component with the largest |n|,

@@ -165,8 +165,8 @@ namespace knee_contact
       // (1/x, log(y - 1)) would hide.
       Point<dim> generic;
       for (unsigned int d = 0; d < dim; ++d)
-        generic[d] = std::array<double, 3>{{0.123456789, 0.234567891,
-                                            0.345678912}}[d];
+        generic[d] =
+          std::array<double, 3>{{0.123456789, 0.234567891, 0.345678912}}[d];
       const std::string variables = dim == 2 ? "x,y" : "x,y,z";
       try
         {

@@ -1,10 +1,10 @@
-#include <knee_contact/physics/elasticity.h>
-#include <knee_contact/physics/elements.h>
 #include <knee_contact/core/input.h>
 #include <knee_contact/core/problem.h>
-#include <knee_contact/physics/rigid_modes.h>
-#include <knee_contact/mesh/scene_checks.h>
 #include <knee_contact/core/scene_file.h>
+#include <knee_contact/mesh/scene_checks.h>
+#include <knee_contact/physics/elasticity.h>
+#include <knee_contact/physics/elements.h>
+#include <knee_contact/physics/rigid_modes.h>
 
 #include <deal.II/base/data_out_base.h>
 #include <deal.II/base/timer.h>
@@ -91,7 +91,7 @@ namespace knee_contact
   template <int dim>
   void
   ContactProblem<dim>::declare_parameters(ParameterHandler &prm,
-                                     const Counts     &counts)
+                                          const Counts     &counts)
   {
     MeshInput<dim>::declare_parameters(prm);
     Materials<dim>::declare_parameters(prm, counts.n_materials);

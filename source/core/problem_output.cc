@@ -120,8 +120,8 @@ namespace knee_contact
   {
     const std::vector<double>          &t = load_cases.values();
     std::vector<LoadCases::Record<dim>> records;
-    const auto                     record = [&](const double   t_case,
-                            const double   solve_time,
+    const auto                          record = [&](const double        t_case,
+                            const double        solve_time,
                             const Results<dim> &results) {
       LoadCases::Record<dim> r;
       r.t            = t_case;
@@ -217,7 +217,7 @@ namespace knee_contact
     // Per unit thickness in 2D.
     const std::string force_unit  = dim == 2 ? "[N/m]" : "[N]  ";
     const std::string energy_unit = dim == 2 ? "[J/m]" : "[J]  ";
-    const auto        list = [](const auto &v, const auto &shown) {
+    const auto        list        = [](const auto &v, const auto &shown) {
       std::ostringstream text;
       text << std::scientific << std::setprecision(6);
       for (unsigned int d = 0; d < dim; ++d)
@@ -229,8 +229,7 @@ namespace knee_contact
         << "  dofs " << results.n_dofs << ", cells " << results.n_cells
         << ", bodies " << results.n_bodies << "\n"
         << "  applied load " << force_unit << "           "
-        << list(results.applied_load, [](const double f) { return f; })
-        << "\n";
+        << list(results.applied_load, [](const double f) { return f; }) << "\n";
     // A reaction component that is zero by physics comes out as round-off
     // of the force scale (1e-8 N/m beside 1e6 N/m); printed as it is, it
     // would make every comparison of this table with an earlier run fail on
@@ -292,15 +291,15 @@ namespace knee_contact
 
 
 
-#define KNEE_CONTACT_INSTANTIATE(dim)                                         \
-  template void ContactProblem<dim>::write_result_set(                        \
-    const Results<dim> &,                                                     \
-    const std::vector<std::vector<CycleRecord>> &,                            \
-    TimerOutput &);                                                           \
-  template unsigned int ContactProblem<dim>::run_load_cases(                  \
-    const Results<dim> &,                                                     \
-    const std::vector<std::vector<CycleRecord>> &,                            \
-    TimerOutput &);                                                           \
+#define KNEE_CONTACT_INSTANTIATE(dim)                        \
+  template void ContactProblem<dim>::write_result_set(       \
+    const Results<dim> &,                                    \
+    const std::vector<std::vector<CycleRecord>> &,           \
+    TimerOutput &);                                          \
+  template unsigned int ContactProblem<dim>::run_load_cases( \
+    const Results<dim> &,                                    \
+    const std::vector<std::vector<CycleRecord>> &,           \
+    TimerOutput &);                                          \
   template void ContactProblem<dim>::print_results(const Results<dim> &) const;
   KNEE_CONTACT_INSTANTIATE(2)
   KNEE_CONTACT_INSTANTIATE(3)

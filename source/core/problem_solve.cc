@@ -2,9 +2,9 @@
 // refinement cycle (ContactProblem's orchestration, split from problem.cc
 // by job as ASPECT splits its Simulator).
 #include <knee_contact/core/problem.h>
+#include <knee_contact/mesh/scene_checks.h>
 #include <knee_contact/physics/elasticity.h>
 #include <knee_contact/physics/rigid_modes.h>
-#include <knee_contact/mesh/scene_checks.h>
 
 #include <deal.II/base/timer.h>
 #include <deal.II/base/utilities.h>
@@ -22,8 +22,8 @@ namespace knee_contact
   template <int dim>
   std::vector<CycleRecord>
   ContactProblem<dim>::run_cycles(const Refinement::Strategy strategy,
-                             TimerOutput               &timer,
-                             Results<dim>              &results)
+                                  TimerOutput               &timer,
+                                  Results<dim>              &results)
   {
     std::vector<CycleRecord> records;
     const unsigned int       n_cycles = strategy == Refinement::Strategy::global
@@ -99,9 +99,9 @@ namespace knee_contact
         previous_contact.clear();
         for (unsigned int p = 0; p < contact_pairs.size(); ++p)
           if (contact_solution.active[p])
-            previous_contact.emplace_back(
-              contact_pairs.points[p].position,
-              std::pow(contact_pairs.rows[p].length, 1. / (dim - 1)));
+            previous_contact.emplace_back(contact_pairs.points[p].position,
+                                          std::pow(contact_pairs.rows[p].length,
+                                                   1. / (dim - 1)));
         record.n_cells        = triangulation.n_active_cells();
         record.n_dofs         = dof_handler.n_dofs();
         record.n_pairs        = contact_pairs.size();
@@ -133,10 +133,10 @@ namespace knee_contact
   template <int dim>
   void
   ContactProblem<dim>::solve_contact(const std::vector<bool> &guess,
-                                const bool               new_matrix)
+                                     const bool               new_matrix)
   {
     const RigidModes<dim> rigid_modes(dof_handler, body_of_cell, body_names);
-    std::ostream    &loop_log = contact_pairs.empty() ? quiet : std::cout;
+    std::ostream         &loop_log = contact_pairs.empty() ? quiet : std::cout;
     try
       {
         Timer clock;
@@ -245,12 +245,12 @@ namespace knee_contact
 
 
 
-#define KNEE_CONTACT_INSTANTIATE(dim)                                        \
-  template std::vector<CycleRecord> ContactProblem<dim>::run_cycles(         \
-    const Refinement::Strategy, TimerOutput &, Results<dim> &);              \
+#define KNEE_CONTACT_INSTANTIATE(dim)                                         \
+  template std::vector<CycleRecord> ContactProblem<dim>::run_cycles(          \
+    const Refinement::Strategy, TimerOutput &, Results<dim> &);               \
   template void ContactProblem<dim>::solve_contact(const std::vector<bool> &, \
-                                                   const bool);              \
-  template Results<dim> ContactProblem<dim>::current_results() const;        \
+                                                   const bool);               \
+  template Results<dim> ContactProblem<dim>::current_results() const;         \
   template void         ContactProblem<dim>::set_load_parameter(const double);
   KNEE_CONTACT_INSTANTIATE(2)
   KNEE_CONTACT_INSTANTIATE(3)

@@ -53,8 +53,8 @@ namespace knee_contact
                                    b = cell->vertex(next[1]) - cell->vertex(v),
                                    c = cell->vertex(next[2]) - cell->vertex(v);
               const double sign =
-                (((v & 1) + ((v >> 1) & 1) + ((v >> 2) & 1)) % 2 == 0) ? 1. :
-                                                                         -1.;
+                (((v & 1) + ((v >> 1) & 1) + ((v >> 2) & 1)) % 2 == 0) ? 1.
+                                                                       : -1.;
               ok &= sign * (cross_product_3d(a, b) * c) >
                     1e-12 * a.norm() * b.norm() * c.norm();
             }
@@ -62,7 +62,8 @@ namespace knee_contact
           {
             std::string centre;
             for (unsigned int d = 0; d < dim; ++d)
-              centre += (d == 0 ? "" : ", ") + std::to_string(cell->center()[d]);
+              centre +=
+                (d == 0 ? "" : ", ") + std::to_string(cell->center()[d]);
             AssertThrow(false,
                         ExcMessage("Mesh: cell at (" + centre +
                                    ") is inverted, degenerate or not convex" +

@@ -28,9 +28,6 @@ namespace knee_contact
 
 
 
-
-
-
     std::vector<std::string>
     arguments(const std::string &text)
     {

@@ -1,6 +1,6 @@
-#include <knee_contact/mesh/gmsh_input.h>
 #include <knee_contact/core/input.h>
 #include <knee_contact/core/interruption.h>
+#include <knee_contact/mesh/gmsh_input.h>
 #include <knee_contact/mesh/mesh.h>
 #include <knee_contact/mesh/mesh_readers.h>
 
@@ -8,17 +8,16 @@
 #include <deal.II/grid/grid_tools.h>
 #include <deal.II/grid/manifold_lib.h>
 
-#include <iomanip>
-#include <memory>
-#include <sstream>
-
 #include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <limits>
+#include <memory>
 #include <numeric>
+#include <sstream>
 #include <tuple>
 
 namespace knee_contact
@@ -270,13 +269,15 @@ namespace knee_contact
     // Refuse early a mesh the machine cannot hold: about 8 kB per cell in
     // 2D for matrix, factorisation and vectors (measured: 1.8 GB for
     // 236 544 cells with contact); in 3D the factor fills in more:
-    // measured 35 kB per hexahedron at 3.3e4 cells, growing with the mesh.
-    const double n_cells = triangulation.n_active_cells() *
-                           std::pow(double(1u << dim), n_refine);
+    // measured 1.3 GB peak for 32 768 hexahedra (1.1e5 DoFs), 35 kB per
+    // cell, and 21 kB at 4 096 (about cells^(1/4)); estimated with
+    // cells^(1/3) above 3.3e4 to stay on the safe side.
+    const double n_cells =
+      triangulation.n_active_cells() * std::pow(double(1u << dim), n_refine);
     const double needed =
       (dim == 2 ? 8e3 : 3.5e4 * std::max(1., std::cbrt(n_cells / 3.3e4))) *
       n_cells;
-    double       available = 0;
+    double available = 0;
     {
       std::ifstream meminfo("/proc/meminfo");
       std::string   key;
@@ -358,19 +359,19 @@ namespace knee_contact
               if constexpr (dim == 2)
                 {
                   AssertThrow(
-                  r0 > 0 && std::abs(r0 - r1) <= 1e-6 * std::max(r0, r1) &&
-                    face->vertex(0).distance(face->vertex(1)) <
-                      std::max(r0, r1),
-                  ExcMessage("Mesh/Circular boundaries: the edge of boundary "
-                             "id " +
-                             std::to_string(id) + " from (" +
-                             std::to_string(face->vertex(0)[0]) + ", " +
-                             std::to_string(face->vertex(0)[1]) + ") to (" +
-                             std::to_string(face->vertex(1)[0]) + ", " +
-                             std::to_string(face->vertex(1)[1]) +
-                             ") is not an arc about the given centre (radii " +
-                             std::to_string(r0) + " and " +
-                             std::to_string(r1) + ")"));
+                    r0 > 0 && std::abs(r0 - r1) <= 1e-6 * std::max(r0, r1) &&
+                      face->vertex(0).distance(face->vertex(1)) <
+                        std::max(r0, r1),
+                    ExcMessage(
+                      "Mesh/Circular boundaries: the edge of boundary "
+                      "id " +
+                      std::to_string(id) + " from (" +
+                      std::to_string(face->vertex(0)[0]) + ", " +
+                      std::to_string(face->vertex(0)[1]) + ") to (" +
+                      std::to_string(face->vertex(1)[0]) + ", " +
+                      std::to_string(face->vertex(1)[1]) +
+                      ") is not an arc about the given centre (radii " +
+                      std::to_string(r0) + " and " + std::to_string(r1) + ")"));
                 }
               else
                 {

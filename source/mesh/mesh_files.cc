@@ -1,6 +1,6 @@
-#include <knee_contact/mesh/gmsh_input.h>
 #include <knee_contact/core/input.h>
 #include <knee_contact/core/interruption.h>
+#include <knee_contact/mesh/gmsh_input.h>
 #include <knee_contact/mesh/mesh.h>
 #include <knee_contact/mesh/mesh_readers.h>
 
@@ -8,17 +8,16 @@
 #include <deal.II/grid/grid_tools.h>
 #include <deal.II/grid/manifold_lib.h>
 
-#include <iomanip>
-#include <memory>
-#include <sstream>
-
 #include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <limits>
+#include <memory>
 #include <numeric>
+#include <sstream>
 #include <tuple>
 
 
@@ -110,8 +109,8 @@ namespace knee_contact
   {
     prm.enter_subsection("Mesh");
     const bool        from_file = prm.get("Source") == "file";
-    const std::string file = input::resolve_path(prm.get("File"), scene_file);
-    const auto arguments   = gmsh_input::arguments(prm.get("Gmsh arguments"));
+    const std::string file  = input::resolve_path(prm.get("File"), scene_file);
+    const auto   arguments  = gmsh_input::arguments(prm.get("Gmsh arguments"));
     const double time_limit = prm.get_double("Gmsh time limit");
     prm.leave_subsection();
     const auto extension = std::filesystem::path(file).extension();
@@ -135,7 +134,8 @@ namespace knee_contact
     if (level > 0)
       {
         const double factor = std::pow(0.5, level);
-        const auto   it = std::find(arguments.begin(), arguments.end(), "-clscale");
+        const auto   it =
+          std::find(arguments.begin(), arguments.end(), "-clscale");
         std::ostringstream scale;
         scale << std::setprecision(17)
               << factor * (it != arguments.end() && it + 1 != arguments.end()
@@ -415,7 +415,7 @@ namespace knee_contact
 
 
 #define KNEE_CONTACT_INSTANTIATE(dim)                                        \
-  template mesh_readers::Description<dim> MeshInput<dim>::read_gmsh(        \
+  template mesh_readers::Description<dim> MeshInput<dim>::read_gmsh(         \
     const unsigned int) const;                                               \
   template mesh_readers::Description<2> MeshInput<dim>::read_vtk() const;    \
   template void MeshInput<dim>::read_file(Triangulation<dim> &,              \

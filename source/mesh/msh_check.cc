@@ -189,11 +189,11 @@ namespace knee_contact
               return {8, 3};
             case 6:
             case 7:
-              reader.fail(std::string(type == 6 ? "wedges (prisms)"
-                                                : "pyramids") +
-                          " (element type " + std::to_string(type) +
-                          ") are not supported; mesh the volumes with "
-                          "tetrahedra (4) or hexahedra (5) only");
+              reader.fail(
+                std::string(type == 6 ? "wedges (prisms)" : "pyramids") +
+                " (element type " + std::to_string(type) +
+                ") are not supported; mesh the volumes with "
+                "tetrahedra (4) or hexahedra (5) only");
             default:
               reader.fail("element type " + std::to_string(type) +
                           " is not supported (points 15, lines 1, triangles "
@@ -207,13 +207,14 @@ namespace knee_contact
       // pyramids.
       struct CellKinds
       {
-        unsigned int dimension = 0;
+        unsigned int dimension  = 0;
         bool         tetrahedra = false, hexahedra = false;
 
         void
         add(const long long type, const MshReader &reader)
         {
-          dimension = std::max(dimension, nodes_and_dimension(type, reader).second);
+          dimension =
+            std::max(dimension, nodes_and_dimension(type, reader).second);
           (type == 4 ? tetrahedra : hexahedra) |= type == 4 || type == 5;
           if (tetrahedra && hexahedra)
             reader.fail("the mesh has tetrahedra and hexahedra; a 3D mesh "
@@ -226,7 +227,7 @@ namespace knee_contact
       unsigned int
       check_msh2(MshReader &reader)
       {
-        CellKinds                     kinds;
+        CellKinds kinds;
         // A face without a physical group is a cell without a material id
         // if the mesh is 2D, a boundary without an id if it is 3D: known
         // only at the end, so the first one is remembered.
@@ -263,7 +264,7 @@ namespace knee_contact
                                "element count");
                 for (unsigned long long i = 0; i < n; ++i)
                   {
-                    t = reader.expect(4, 64, "an element");
+                    t                    = reader.expect(4, 64, "an element");
                     const long long type = reader.tag(t[1], "element type");
                     const auto [n_v, element_dim] =
                       nodes_and_dimension(type, reader);
@@ -407,7 +408,7 @@ namespace knee_contact
                 for (unsigned long long b = 0; b < n_blocks; ++b)
                   {
                     t = reader.expect(4, 4, "an element block header");
-                    const long long type = reader.tag(t[2], "element type");
+                    const long long    type = reader.tag(t[2], "element type");
                     const unsigned int n_v =
                       nodes_and_dimension(type, reader).first;
                     kinds.add(type, reader);

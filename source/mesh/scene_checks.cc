@@ -94,8 +94,8 @@ namespace knee_contact
       for (const auto &cell : triangulation.active_cell_iterators())
         {
           const Material<dim> &material = materials[cell->material_id()];
-          const auto       &force    = *material.body_force;
-          const std::string parameter =
+          const auto          &force    = *material.body_force;
+          const std::string    parameter =
             "Materials (material '" + material.name + "')/Body force";
           for (const auto v : cell->vertex_indices())
             check(force, cell->vertex(v), parameter, "");
@@ -161,8 +161,8 @@ namespace knee_contact
         {
           if (cells_at[v].size() < 2)
             continue;
-          std::vector<typename Triangulation<dim>::active_cell_iterator>
-            around(cells_at[v].begin(), cells_at[v].end());
+          std::vector<typename Triangulation<dim>::active_cell_iterator> around(
+            cells_at[v].begin(), cells_at[v].end());
           std::vector<unsigned int> parent(around.size());
           std::iota(parent.begin(), parent.end(), 0);
           const auto find = [&](unsigned int i) {

@@ -1,6 +1,6 @@
+#include <knee_contact/core/input.h>
 #include <knee_contact/physics/boundary_conditions.h>
 #include <knee_contact/physics/elements.h>
-#include <knee_contact/core/input.h>
 
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/fe/mapping_q1.h>
@@ -13,7 +13,7 @@ namespace knee_contact
   template <int dim>
   void
   BoundaryConditions<dim>::declare_parameters(ParameterHandler  &prm,
-                                         const unsigned int n_conditions)
+                                              const unsigned int n_conditions)
   {
     prm.enter_subsection("Boundary conditions");
     prm.declare_entry("Number of conditions",
@@ -61,7 +61,7 @@ namespace knee_contact
   template <int dim>
   void
   BoundaryConditions<dim>::parse_parameters(ParameterHandler  &prm,
-                                       const unsigned int n_conditions)
+                                            const unsigned int n_conditions)
   {
     prm.enter_subsection("Boundary conditions");
     std::map<types::boundary_id, std::string> used;
@@ -116,7 +116,8 @@ namespace knee_contact
 
   template <int dim>
   void
-  BoundaryConditions<dim>::check_mesh(const Triangulation<dim> &triangulation) const
+  BoundaryConditions<dim>::check_mesh(
+    const Triangulation<dim> &triangulation) const
   {
     const auto ids = triangulation.get_boundary_ids();
     for (const auto &condition : list)

@@ -72,9 +72,9 @@ namespace knee_contact
 
   template <int dim>
   void
-  ElasticityAssembler<dim>::assemble(const DoFHandler<dim>  &dof_handler,
-                                SparseMatrix<double> &matrix,
-                                Vector<double>       &rhs) const
+  ElasticityAssembler<dim>::assemble(const DoFHandler<dim> &dof_handler,
+                                     SparseMatrix<double>  &matrix,
+                                     Vector<double>        &rhs) const
   {
     matrix = 0;
     assemble(dof_handler, &matrix, rhs);
@@ -85,7 +85,7 @@ namespace knee_contact
   template <int dim>
   void
   ElasticityAssembler<dim>::assemble_rhs(const DoFHandler<dim> &dof_handler,
-                                    Vector<double>      &rhs) const
+                                         Vector<double>        &rhs) const
   {
     assemble(dof_handler, nullptr, rhs);
   }
@@ -94,9 +94,9 @@ namespace knee_contact
 
   template <int dim>
   void
-  ElasticityAssembler<dim>::assemble(const DoFHandler<dim>  &dof_handler,
-                                SparseMatrix<double> *matrix,
-                                Vector<double>       &rhs) const
+  ElasticityAssembler<dim>::assemble(const DoFHandler<dim> &dof_handler,
+                                     SparseMatrix<double>  *matrix,
+                                     Vector<double>        &rhs) const
   {
     rhs.reinit(dof_handler.n_dofs());
     const bool with_matrix = matrix != nullptr;
@@ -104,9 +104,10 @@ namespace knee_contact
     // a(u, v) = int e(v) : c : e(u) dx and L(v) = int F.v dx + int P.v ds,
     // the seed's eq. (5), cell by cell.
     const auto worker = [this, with_matrix](
-                          const typename DoFHandler<dim>::active_cell_iterator &cell,
-                          ScratchData<dim>                          &scratch,
-                          CopyData                                  &copy) {
+                          const typename DoFHandler<dim>::active_cell_iterator
+                                           &cell,
+                          ScratchData<dim> &scratch,
+                          CopyData         &copy) {
       const FiniteElement<dim> &fe       = cell->get_fe();
       const unsigned int        n        = fe.n_dofs_per_cell();
       const Material<dim>      &material = materials[cell->material_id()];
@@ -127,7 +128,7 @@ namespace knee_contact
             material.body_force->vector_value(fev.quadrature_point(q), force);
           for (unsigned int i = 0; i < n; ++i)
             {
-              const unsigned int ci = fe.system_to_component_index(i).first;
+              const unsigned int   ci = fe.system_to_component_index(i).first;
               const Tensor<1, dim> gi = fev.shape_grad(i, q);
               for (unsigned int j = 0; with_matrix && j < n; ++j)
                 {

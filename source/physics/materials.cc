@@ -52,7 +52,7 @@ namespace knee_contact
   template <int dim>
   void
   Materials<dim>::declare_parameters(ParameterHandler  &prm,
-                                const unsigned int n_materials)
+                                     const unsigned int n_materials)
   {
     prm.enter_subsection("Materials");
     prm.declare_entry("Number of materials",
@@ -109,7 +109,7 @@ namespace knee_contact
   template <int dim>
   void
   Materials<dim>::parse_parameters(ParameterHandler  &prm,
-                              const unsigned int n_materials)
+                                   const unsigned int n_materials)
   {
     prm.enter_subsection("Materials");
     const bool plane_strain = prm.get("Plane") == "strain";
@@ -124,7 +124,7 @@ namespace knee_contact
                                std::to_string(id) +
                                " is given to more than one material"));
         Material<dim> &material = materials[id];
-        material.name      = prm.get("Name");
+        material.name           = prm.get("Name");
         input::check_name(material.name, "Materials/" + section + "/Name");
         for (const auto &[other_id, other] : materials)
           AssertThrow(other_id == id || other.name != material.name,
@@ -163,9 +163,9 @@ namespace knee_contact
         material.body_force =
           input::parse_expression<dim>(prm.get("Body force"),
                                        dim,
-                                  "Materials/" + section + "/Body force",
-                                  "",
-                                  true);
+                                       "Materials/" + section + "/Body force",
+                                       "",
+                                       true);
         // Written as zeros ("0; 0", the 2D default): assembly skips it.
         material.body_force_is_zero = true;
         for (const auto &part : input::split(prm.get("Body force"), ';'))

@@ -94,8 +94,8 @@ namespace knee_contact
         double norm = 0;
         for (const auto &[dof, v] : row)
           {
-            const unsigned int    b = dof_body[dof];
-            const unsigned int    c = dof_component[dof];
+            const unsigned int   b = dof_body[dof];
+            const unsigned int   c = dof_component[dof];
             const Tensor<1, dim> r = dof_position[dof] - centre[b];
             w(n_modes * b + c) += v;
             if constexpr (dim == 2)
@@ -105,8 +105,8 @@ namespace knee_contact
               for (unsigned int k = 0; k < 3; ++k)
                 if (k != c)
                   {
-                    const unsigned int j = 3 - k - c;
-                    const double sign = (k + 1) % 3 == j ? 1. : -1.;
+                    const unsigned int j    = 3 - k - c;
+                    const double       sign = (k + 1) % 3 == j ? 1. : -1.;
                     w(n_modes * b + 3 + k) += v * sign * r[j] / size[b];
                   }
             norm += v * v;
@@ -149,7 +149,8 @@ namespace knee_contact
       {
         double m = 0;
         for (unsigned int k = 0; k < n_modes; ++k)
-          m += eigenvectors(n_modes * b + k, 0) * eigenvectors(n_modes * b + k, 0);
+          m +=
+            eigenvectors(n_modes * b + k, 0) * eigenvectors(n_modes * b + k, 0);
         if (m > largest_motion + 1e-12)
           {
             largest_motion = m;
@@ -193,9 +194,8 @@ namespace knee_contact
         if constexpr (dim == 2)
           motion << "rotation about (" << p[0] << ", " << p[1] << ")";
         else
-          motion << "rotation about the axis through (" << p[0] << ", "
-                 << p[1] << ", " << p[2] << ") along "
-                 << list(omega, omega.norm());
+          motion << "rotation about the axis through (" << p[0] << ", " << p[1]
+                 << ", " << p[2] << ") along " << list(omega, omega.norm());
       }
     else
       motion << "translation along " << list(t, t.norm());

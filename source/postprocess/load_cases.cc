@@ -94,7 +94,8 @@ namespace knee_contact
     const Results<dim> &first = records.front().results;
     out << "case,t,iterations,converged,solve_time,energy,max_displacement";
     for (unsigned int d = 0; d < dim; ++d)
-      out << ",load_" << "xyz"[d];
+      out << ",load_"
+          << "xyz"[d];
     for (const auto &[id, reaction] : first.reactions)
       for (unsigned int d = 0; d < dim; ++d)
         out << ",reaction_" << id << '_' << "xyz"[d];
@@ -135,8 +136,8 @@ namespace knee_contact
         << (with_times ? "  solve [s]" : "") << '\n';
     for (unsigned int c = 0; c < records.size(); ++c)
       {
-        const Record<dim> &r = records[c];
-        double        peak = 0, length = 0;
+        const Record<dim> &r    = records[c];
+        double             peak = 0, length = 0;
         for (const auto &i : r.results.interfaces)
           {
             peak = std::max(peak, i.max_pressure);

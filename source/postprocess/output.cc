@@ -1,6 +1,6 @@
-#include <knee_contact/physics/elements.h>
 #include <knee_contact/core/external_program.h>
 #include <knee_contact/core/input.h>
+#include <knee_contact/physics/elements.h>
 #include <knee_contact/postprocess/output.h>
 
 #include <deal.II/numerics/data_out.h>
@@ -129,7 +129,7 @@ namespace knee_contact
   template <int dim>
   void
   OutputWriter<dim>::parse_parameters(ParameterHandler  &prm,
-                                 const std::string &scene_file)
+                                      const std::string &scene_file)
   {
     prm.enter_subsection("Output");
     output_folder = prm.get("Folder");
@@ -143,8 +143,7 @@ namespace knee_contact
     picture_time_limit = prm.get_double("Picture time limit");
     for (const auto &[name, point] :
          input::split_named(prm.get("Labels"), "Output/Labels", "name: x, y"))
-      labels.emplace_back(name,
-                          input::to_point<dim>(point, "Output/Labels"));
+      labels.emplace_back(name, input::to_point<dim>(point, "Output/Labels"));
     prm.leave_subsection();
   }
 
@@ -234,7 +233,7 @@ namespace knee_contact
   template <int dim>
   bool
   OutputWriter<dim>::run_script(const std::string &script_name,
-                           std::string       &message) const
+                                std::string       &message) const
   {
     if (!write_files || !pictures)
       return true;
@@ -277,11 +276,11 @@ namespace knee_contact
   {
     using json = nlohmann::ordered_json;
     json summary;
-    summary["n_dofs"]               = results.n_dofs;
-    summary["n_cells"]              = results.n_cells;
-    summary["n_bodies"]             = results.n_bodies;
-    summary["elements"]             = results.elements;
-    const auto vector = [](const auto &v) {
+    summary["n_dofs"]   = results.n_dofs;
+    summary["n_cells"]  = results.n_cells;
+    summary["n_bodies"] = results.n_bodies;
+    summary["elements"] = results.elements;
+    const auto vector   = [](const auto &v) {
       std::vector<double> components(dim);
       for (unsigned int d = 0; d < dim; ++d)
         components[d] = v[d];

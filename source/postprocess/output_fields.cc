@@ -169,7 +169,7 @@ namespace knee_contact
     flags.compression_level = DataOutBase::VtkFlags::best_speed;
     data_out.set_flags(flags);
     write_file("solution.vtu",
-                  [&](std::ostream &out) { data_out.write_vtu(out); });
+               [&](std::ostream &out) { data_out.write_vtu(out); });
   }
 
 
@@ -249,9 +249,8 @@ namespace knee_contact
               }
       }
     const std::string name = dim == 2 ? "cells.npy" : "surface.npy";
-    write_file(name, [&](std::ostream &out) {
-      write_npy(out, data, n_columns);
-    });
+    write_file(name,
+               [&](std::ostream &out) { write_npy(out, data, n_columns); });
   }
 
 
@@ -300,8 +299,8 @@ namespace knee_contact
               const ContactPoint<dim> &point = pairs.points[order[k]];
               const ContactRow        &row   = pairs.rows[order[k]];
               if (k > 0)
-                s += point.position.distance(
-                  pairs.points[order[k - 1]].position);
+                s +=
+                  point.position.distance(pairs.points[order[k - 1]].position);
               out << s << ',' << point.position[0] << ',' << point.position[1]
                   << ',' << point.normal[0] << ',' << point.normal[1] << ','
                   << row.gap << ',' << row.jump(solution) << ','
@@ -315,24 +314,25 @@ namespace knee_contact
 
 
 
-#define KNEE_CONTACT_INSTANTIATE(dim)                                         \
-  template void OutputWriter<dim>::write_vtu(const DoFHandler<dim> &,         \
-                                             const std::vector<unsigned int> &, \
-                                             const Vector<double> &,          \
-                                             const Materials<dim> &,          \
-                                             const ContactPairs<dim> &,       \
-                                             const ContactSolution &,         \
-                                             const Results<dim> &) const;     \
-  template void OutputWriter<dim>::write_cells(                               \
-    const DoFHandler<dim> &,                                                  \
-    const std::vector<unsigned int> &,                                        \
-    const Vector<double> &,                                                   \
-    const Results<dim> &) const;                                              \
-  template void OutputWriter<dim>::write_contact_csv(                         \
-    const ContactInterfaces &,                                                \
-    const ContactPairs<dim> &,                                                \
-    const Vector<double> &,                                                   \
-    const ContactSolution &,                                                  \
+#define KNEE_CONTACT_INSTANTIATE(dim)                 \
+  template void OutputWriter<dim>::write_vtu(         \
+    const DoFHandler<dim> &,                          \
+    const std::vector<unsigned int> &,                \
+    const Vector<double> &,                           \
+    const Materials<dim> &,                           \
+    const ContactPairs<dim> &,                        \
+    const ContactSolution &,                          \
+    const Results<dim> &) const;                      \
+  template void OutputWriter<dim>::write_cells(       \
+    const DoFHandler<dim> &,                          \
+    const std::vector<unsigned int> &,                \
+    const Vector<double> &,                           \
+    const Results<dim> &) const;                      \
+  template void OutputWriter<dim>::write_contact_csv( \
+    const ContactInterfaces &,                        \
+    const ContactPairs<dim> &,                        \
+    const Vector<double> &,                           \
+    const ContactSolution &,                          \
     const Results<dim> &) const;
   KNEE_CONTACT_INSTANTIATE(2)
   KNEE_CONTACT_INSTANTIATE(3)

@@ -96,9 +96,9 @@ namespace knee_contact
                                        dof_handler,
                                        elements::face_quadrature(dof_handler,
                                                                  2),
-                                     {},
-                                     solution,
-                                     kelly);
+                                       {},
+                                       solution,
+                                       kelly);
     for (const auto &cell : triangulation.active_cell_iterators())
       kelly(cell->active_cell_index()) *=
         std::sqrt(materials[cell->material_id()].youngs_modulus);
@@ -114,8 +114,8 @@ namespace knee_contact
         for (unsigned int p = 0; p < pairs.size(); ++p)
           if (contact.active[p])
             zone.emplace_back(pairs.points[p].position,
-                              2 * std::pow(pairs.rows[p].length,
-                                           1. / (dim - 1)));
+                              2 *
+                                std::pow(pairs.rows[p].length, 1. / (dim - 1)));
         for (const auto &cell : triangulation.active_cell_iterators())
           for (const unsigned int v : cell->vertex_indices())
             for (const auto &[centre, radius] : zone)

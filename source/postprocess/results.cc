@@ -107,7 +107,7 @@ namespace knee_contact
     // prescribed displacements the force E max|u| that straining a body of
     // unit size by max|u| takes.
     Tensor<1, dim> balance = results.applied_load;
-    double       scale =
+    double         scale =
       std::max(results.applied_load.norm(),
                materials.max_youngs_modulus() * results.max_displacement);
     for (const auto &reaction : results.reactions)
@@ -137,13 +137,12 @@ namespace knee_contact
         fe_values[displacement].get_function_symmetric_gradients(solution,
                                                                  strains);
         const Material<dim> &material = materials[cell->material_id()];
-        auto            range    = results.stress_yy_range.emplace(
+        auto                 range    = results.stress_yy_range.emplace(
           cell->material_id(),
           std::make_pair(std::numeric_limits<double>::max(),
                          -std::numeric_limits<double>::max()));
         double &von_mises_max = results.von_mises_max[cell->material_id()];
-        for (unsigned int v = 0; v < GeometryInfo<dim>::vertices_per_cell;
-             ++v)
+        for (unsigned int v = 0; v < GeometryInfo<dim>::vertices_per_cell; ++v)
           {
             const SymmetricTensor<2, dim> stress =
               material.stress(strains[std::min(v, n_vertices - 1)]);

@@ -1,5 +1,5 @@
-#include <knee_contact/physics/elements.h>
 #include <knee_contact/core/input.h>
+#include <knee_contact/physics/elements.h>
 #include <knee_contact/postprocess/verification.h>
 
 #include <deal.II/base/quadrature_lib.h>
@@ -207,13 +207,13 @@ namespace knee_contact
         // Gauss points; the exact gradient comes from fourth order
         // differences of the expression.
         FEValues<dim> fe_values(elements::mapping(dof_handler),
-                              dof_handler.get_fe(),
-                              elements::cell_quadrature(dof_handler, 3),
-                              update_values | update_gradients |
-                                update_quadrature_points | update_JxW_values);
-        const FEValuesExtractors::Vector   u(0);
-        const unsigned int                 n_q = fe_values.n_quadrature_points;
-        std::vector<Tensor<1, dim>>          values(n_q);
+                                dof_handler.get_fe(),
+                                elements::cell_quadrature(dof_handler, 3),
+                                update_values | update_gradients |
+                                  update_quadrature_points | update_JxW_values);
+        const FEValuesExtractors::Vector u(0);
+        const unsigned int               n_q = fe_values.n_quadrature_points;
+        std::vector<Tensor<1, dim>>      values(n_q);
         std::vector<SymmetricTensor<2, dim>> strains(n_q);
         std::vector<Vector<double>> exact_values(n_q, Vector<double>(dim));
         std::vector<std::vector<Tensor<1, dim>>> exact_gradients(
@@ -268,9 +268,9 @@ namespace knee_contact
                     for (unsigned int c = 0; c < components.size(); ++c)
                       {
                         const auto [i, j] = components[c];
-                        stress_error      = std::max(stress_error,
-                                                std::abs(s[i][j] -
-                                                         stress_values(c)));
+                        stress_error =
+                          std::max(stress_error,
+                                   std::abs(s[i][j] - stress_values(c)));
                         stress_max =
                           std::max(stress_max, std::abs(stress_values(c)));
                       }
@@ -370,10 +370,10 @@ namespace knee_contact
   template <int dim>
   unsigned int
   Verification<dim>::check_study(const std::vector<Errors> &uniform_errors,
-                            const std::vector<double> &uniform_dofs,
-                            const std::vector<Errors> &adaptive_errors,
-                            const std::vector<double> &adaptive_dofs,
-                            std::ostream              &out) const
+                                 const std::vector<double> &uniform_dofs,
+                                 const std::vector<Errors> &adaptive_errors,
+                                 const std::vector<double> &adaptive_dofs,
+                                 std::ostream              &out) const
   {
     unsigned int n_failed = 0;
     const auto   pass     = [&](const bool ok) {
@@ -407,11 +407,11 @@ namespace knee_contact
   template <int dim>
   unsigned int
   Verification<dim>::check(const Results<dim>        &results,
-                      const ContactSolution     &contact,
-                      const bool                 has_contact,
-                      const std::vector<Errors> &errors,
-                      const std::vector<double> &n_dofs,
-                      std::ostream              &out) const
+                           const ContactSolution     &contact,
+                           const bool                 has_contact,
+                           const std::vector<Errors> &errors,
+                           const std::vector<double> &n_dofs,
+                           std::ostream              &out) const
   {
     unsigned int n_failed = 0;
     const auto   report   = [&](const std::string &what,

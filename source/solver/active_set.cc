@@ -98,7 +98,7 @@ namespace knee_contact
 
   void
   ActiveSetSolver::make_constraints(const AffineConstraints<double> &base,
-                                    const std::vector<ContactRow>  &pairs,
+                                    const std::vector<ContactRow>   &pairs,
                                     const std::vector<bool>         &active,
                                     AffineConstraints<double> &constraints)
   {
@@ -109,7 +109,7 @@ namespace knee_contact
       if (active[p])
         {
           const ContactRow &pair = pairs[p];
-          double             a_j  = 0;
+          double            a_j  = 0;
           for (const auto &[dof, a] : pair.reduced_row)
             if (dof == pair.eliminated)
               a_j = a;
@@ -130,7 +130,7 @@ namespace knee_contact
   std::vector<double>
   ActiveSetSolver::multipliers(const Vector<double>            &residual,
                                const AffineConstraints<double> &base,
-                               const std::vector<ContactRow>  &pairs,
+                               const std::vector<ContactRow>   &pairs,
                                const std::vector<bool>         &active)
   {
     // Equations at the eliminated dofs j_p of the active pairs:
@@ -194,10 +194,11 @@ namespace knee_contact
 
 
   void
-  ActiveSetSolver::make_sparsity_pattern(const DynamicSparsityPattern &mesh_pattern,
-                                         const AffineConstraints<double> &base,
-                                         const std::vector<ContactRow>  &pairs,
-                                         SparsityPattern &sparsity_pattern)
+  ActiveSetSolver::make_sparsity_pattern(
+    const DynamicSparsityPattern    &mesh_pattern,
+    const AffineConstraints<double> &base,
+    const std::vector<ContactRow>   &pairs,
+    SparsityPattern                 &sparsity_pattern)
   {
     // One sparsity pattern serves every active set. Condensing a set of
     // lines couples each dof i with the dofs its line refers to after
@@ -278,9 +279,9 @@ namespace knee_contact
                                           const Vector<double>       &x,
                                           const AffineConstraints<double> &base,
                                           const std::vector<ContactRow> &pairs,
-                                          const std::vector<bool> &active,
-                                          std::vector<double>     &excess,
-                                          std::vector<double>     &lambda)
+                                          const std::vector<bool>       &active,
+                                          std::vector<double>           &excess,
+                                          std::vector<double>           &lambda)
   {
     Vector<double> residual(rhs.size());
     matrix.residual(residual, x, rhs);
@@ -294,7 +295,7 @@ namespace knee_contact
 
   double
   ActiveSetSolver::displacement_scale(const std::vector<ContactRow> &pairs,
-                                      const Vector<double>           &x)
+                                      const Vector<double>          &x)
   {
     // Over the contact unknowns, as the condensed path sees them.
     double scale = 0;
@@ -311,8 +312,8 @@ namespace knee_contact
   ActiveSetSolver::solve(ContactSystem                   &system,
                          const double                     force_scale_of_load,
                          const AffineConstraints<double> &base,
-                         const std::vector<ContactRow>  &pairs,
-                         const RigidModeCheck                &rigid_modes,
+                         const std::vector<ContactRow>   &pairs,
+                         const RigidModeCheck            &rigid_modes,
                          const std::vector<bool>         &guess,
                          std::ostream                    &log) const
   {

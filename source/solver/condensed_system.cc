@@ -49,7 +49,7 @@ namespace knee_contact
   public:
     const SparseMatrix<double>      &matrix;
     const AffineConstraints<double> &base;
-    const std::vector<ContactRow>  &pairs;
+    const std::vector<ContactRow>   &pairs;
 
     /** Contact unknowns: global dof of each local index, and back. */
     std::vector<types::global_dof_index>                  dofs;
@@ -91,7 +91,7 @@ namespace knee_contact
 
     Implementation(const SparseMatrix<double>      &matrix,
                    const AffineConstraints<double> &base,
-                   const std::vector<ContactRow>  &pairs)
+                   const std::vector<ContactRow>   &pairs)
       : matrix(matrix)
       , base(base)
       , pairs(pairs)
@@ -103,7 +103,7 @@ namespace knee_contact
   CondensedContactSystem::CondensedContactSystem(
     const SparseMatrix<double>      &matrix,
     const AffineConstraints<double> &base,
-    const std::vector<ContactRow>  &pairs,
+    const std::vector<ContactRow>   &pairs,
     const std::vector<int>          &order)
     : implementation(std::make_unique<Implementation>(matrix, base, pairs))
   {
@@ -574,7 +574,7 @@ namespace knee_contact
   reference_solve(const SparseMatrix<double>      &matrix,
                   const Vector<double>            &rhs,
                   const AffineConstraints<double> &base,
-                  const std::vector<ContactRow>  &pairs,
+                  const std::vector<ContactRow>   &pairs,
                   const std::vector<bool>         &active,
                   Vector<double>                  &x)
   {

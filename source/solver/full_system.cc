@@ -10,7 +10,7 @@ namespace knee_contact
 {
   FullContactSystem::FullContactSystem(const SparseMatrix<double>      &matrix,
                                        const AffineConstraints<double> &base,
-                                       const std::vector<ContactRow>  &pairs)
+                                       const std::vector<ContactRow>   &pairs)
     : matrix(matrix)
     , base(base)
     , pairs(pairs)

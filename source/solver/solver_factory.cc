@@ -136,7 +136,7 @@ namespace knee_contact
   make_contact_system(const SolverPath                 requested,
                       const SparseMatrix<double>      &matrix,
                       const AffineConstraints<double> &base,
-                      const std::vector<ContactRow>  &pairs,
+                      const std::vector<ContactRow>   &pairs,
                       const bool                       warm_start,
                       std::ostream                    &log,
                       std::string                     &name,

@@ -98,7 +98,7 @@ namespace knee_contact
   public:
     Implementation(const SparseMatrix<double>      &matrix,
                    const AffineConstraints<double> &base,
-                   const std::vector<ContactRow>  &pairs)
+                   const std::vector<ContactRow>   &pairs)
       : matrix(matrix)
       , base(base)
       , pairs(pairs)
@@ -106,7 +106,7 @@ namespace knee_contact
 
     const SparseMatrix<double>      &matrix;
     const AffineConstraints<double> &base;
-    const std::vector<ContactRow>  &pairs;
+    const std::vector<ContactRow>   &pairs;
     const Vector<double>            *rhs = nullptr;
     sparse_cholesky::SparseCholesky  cholesky;
     std::vector<int>                 order;
@@ -240,7 +240,7 @@ namespace knee_contact
   SparseContactSystem::SparseContactSystem(
     const SparseMatrix<double>      &matrix,
     const AffineConstraints<double> &base,
-    const std::vector<ContactRow>  &pairs)
+    const std::vector<ContactRow>   &pairs)
     : implementation(std::make_unique<Implementation>(matrix, base, pairs))
   {
     Implementation &d = *implementation;

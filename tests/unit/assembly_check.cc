@@ -117,7 +117,7 @@ int
 main()
 {
   ContactProblem<2> problem(SOURCE_DIR "/qp_scene.prm");
-  const int      status = problem.run();
+  const int         status = problem.run();
 
   const DoFHandler<2> &dofs = problem.dof_handler_of();
   const unsigned int   n    = dofs.n_dofs();
@@ -258,8 +258,8 @@ main()
   double mortar_error = mortar.pairs().size() == n_slave ? 0 : 1;
   for (unsigned int p = 0; p < mortar.pairs().size(); ++p)
     {
-      const ContactRow   &pair = mortar.pairs().rows[p];
-      const unsigned int  j =
+      const ContactRow  &pair = mortar.pairs().rows[p];
+      const unsigned int j =
         std::lround(mortar.pairs().points[p].position[0] / hs);
       Vector<double>      expected(mortar_dofs.n_dofs());
       double              W = 0;

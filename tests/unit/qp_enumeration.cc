@@ -26,7 +26,7 @@ namespace
   {
     std::cout << "scene " << scene << std::endl;
     ContactProblem<2> problem(SOURCE_DIR "/" + scene);
-    const int      status = problem.run();
+    const int         status = problem.run();
 
     const auto        &K     = problem.matrix();
     const auto        &f     = problem.rhs();

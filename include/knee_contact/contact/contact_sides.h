@@ -17,8 +17,8 @@ namespace knee_contact
 
   /**
    * The two sides of one 2D contact interface as the contact
-   * discretisations see them: the slave vertices with their averaged normals, the slave
-   * faces, and the master faces. Collected once by
+   * discretisations see them: the slave vertices with their averaged normals,
+   * the slave faces, and the master faces. Collected once by
    * ContactInterfaces::make_pairs(); each discretisation (node-to-segment,
    * mortar) turns them into rows a_p x <= g_p, one per slave vertex.
    */

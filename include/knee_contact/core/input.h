@@ -31,7 +31,8 @@ namespace knee_contact
 
     /**
      * Parse @p expression with @p n_components components (separated by ';')
-     * in the variables x, y (and z in 3D) and the constants "pi" and @p constants
+     * in the variables x, y (and z in 3D) and the constants "pi" and @p
+     * constants
      * ("name=value, ..."). Throws an ExcMessage that names @p parameter if the
      * expression does not parse. A @p load expression (traction, pressure,
      * body force, exact solutions) may also use t, the load parameter of the

@@ -1,18 +1,18 @@
 #ifndef knee_contact_problem_h
 #define knee_contact_problem_h
 
-#include <knee_contact/solver/active_set.h>
-#include <knee_contact/physics/boundary_conditions.h>
 #include <knee_contact/contact/contact.h>
-#include <knee_contact/solver/contact_system.h>
-#include <knee_contact/postprocess/load_cases.h>
-#include <knee_contact/physics/materials.h>
 #include <knee_contact/mesh/mesh.h>
+#include <knee_contact/physics/boundary_conditions.h>
+#include <knee_contact/physics/materials.h>
+#include <knee_contact/postprocess/load_cases.h>
 #include <knee_contact/postprocess/output.h>
 #include <knee_contact/postprocess/refinement.h>
 #include <knee_contact/postprocess/results.h>
 #include <knee_contact/postprocess/study.h>
 #include <knee_contact/postprocess/verification.h>
+#include <knee_contact/solver/active_set.h>
+#include <knee_contact/solver/contact_system.h>
 
 #include <deal.II/base/parameter_handler.h>
 #include <deal.II/base/timer.h>
@@ -238,9 +238,9 @@ namespace knee_contact
     // FE_Q(1)^dim or FE_SimplexP(1)^dim, by the mesh's cells (make_mesh).
     std::unique_ptr<FiniteElement<dim>> fe;
     DoFHandler<dim>                     dof_handler;
-    std::vector<unsigned int>         body_of_cell;
-    unsigned int                      n_bodies = 0;
-    std::vector<std::string>          body_names;
+    std::vector<unsigned int>           body_of_cell;
+    unsigned int                        n_bodies = 0;
+    std::vector<std::string>            body_names;
 
     AffineConstraints<double> constraints;
     ContactPairs<dim>         contact_pairs;

@@ -116,15 +116,15 @@ namespace knee_contact
       file
     };
 
-    Source                                 source = Source::rectangles;
-    std::string                            file;
-    std::vector<std::string>               gmsh_arguments;
-    double                                 gmsh_time_limit = 300;
-    std::vector<Rectangle>                 rectangles;
-    double                                 rotation_degrees = 0;
-    unsigned int                           n_refinements    = 0;
+    Source                                   source = Source::rectangles;
+    std::string                              file;
+    std::vector<std::string>                 gmsh_arguments;
+    double                                   gmsh_time_limit = 300;
+    std::vector<Rectangle>                   rectangles;
+    double                                   rotation_degrees = 0;
+    unsigned int                             n_refinements    = 0;
     std::map<types::boundary_id, Point<dim>> circular_boundaries;
-    bool                                   split_triangles = false;
+    bool                                     split_triangles = false;
     enum class RectangleCells
     {
       quadrilaterals,

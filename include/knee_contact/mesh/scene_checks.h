@@ -1,8 +1,8 @@
 #ifndef knee_contact_scene_checks_h
 #define knee_contact_scene_checks_h
 
-#include <knee_contact/physics/boundary_conditions.h>
 #include <knee_contact/contact/contact.h>
+#include <knee_contact/physics/boundary_conditions.h>
 #include <knee_contact/physics/materials.h>
 
 #include <deal.II/grid/tria.h>

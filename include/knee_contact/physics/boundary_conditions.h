@@ -35,10 +35,10 @@ namespace knee_contact
   template <int dim>
   struct BoundaryCondition
   {
-    std::string                        name;
-    BoundaryType                       type = BoundaryType::displacement;
-    std::set<types::boundary_id>       ids;
-    ComponentMask                      mask;
+    std::string                          name;
+    BoundaryType                         type = BoundaryType::displacement;
+    std::set<types::boundary_id>         ids;
+    ComponentMask                        mask;
     std::unique_ptr<FunctionParser<dim>> function;
   };
 

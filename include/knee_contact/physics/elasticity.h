@@ -33,9 +33,9 @@ namespace knee_contact
      * are overwritten. Cells are assembled in parallel by WorkStream.
      */
     void
-    assemble(const DoFHandler<dim>  &dof_handler,
-             SparseMatrix<double> &matrix,
-             Vector<double>       &rhs) const;
+    assemble(const DoFHandler<dim> &dof_handler,
+             SparseMatrix<double>  &matrix,
+             Vector<double>        &rhs) const;
 
     /**
      * Only the load vector d, for a further load case on the same mesh:
@@ -46,9 +46,9 @@ namespace knee_contact
 
   private:
     void
-    assemble(const DoFHandler<dim>  &dof_handler,
-             SparseMatrix<double> *matrix,
-             Vector<double>       &rhs) const;
+    assemble(const DoFHandler<dim> &dof_handler,
+             SparseMatrix<double>  *matrix,
+             Vector<double>        &rhs) const;
 
     const Materials<dim>          &materials;
     const BoundaryConditions<dim> &boundary_conditions;

@@ -34,7 +34,7 @@ namespace knee_contact
      * with one Gauss point per cell, the standard remedy for the locking of
      * Q1 elements as nu approaches 1/2.
      */
-    bool                               reduced_volumetric = false;
+    bool                                 reduced_volumetric = false;
     std::unique_ptr<FunctionParser<dim>> body_force;
     /** The body force is written as zeros: nothing to integrate. */
     bool body_force_is_zero = false;

@@ -50,7 +50,7 @@ namespace knee_contact
       unsigned int n_iterations = 0;
       bool         converged    = true;
       /** Wall time of the case's solve [s]: load vector to displacement. */
-      double  solve_time = 0;
+      double       solve_time = 0;
       Results<dim> results;
     };
 

@@ -1,11 +1,11 @@
 #ifndef knee_contact_output_h
 #define knee_contact_output_h
 
-#include <knee_contact/solver/active_set.h>
 #include <knee_contact/contact/contact.h>
-#include <knee_contact/physics/materials.h>
 #include <knee_contact/core/result_folder.h>
+#include <knee_contact/physics/materials.h>
 #include <knee_contact/postprocess/results.h>
+#include <knee_contact/solver/active_set.h>
 
 #include <deal.II/base/parameter_handler.h>
 
@@ -153,15 +153,15 @@ namespace knee_contact
     /** "" or the current case's folder with a trailing '/'. */
     std::string subfolder;
 
-    std::unique_ptr<ResultFolder>                 result_folder;
-    std::vector<std::string>                      warnings;
-    double                                        picture_time_limit = 600;
-    std::string                                   output_folder;
-    double                                        magnification = 10;
-    bool                                          pictures      = true;
+    std::unique_ptr<ResultFolder>                   result_folder;
+    std::vector<std::string>                        warnings;
+    double                                          picture_time_limit = 600;
+    std::string                                     output_folder;
+    double                                          magnification = 10;
+    bool                                            pictures      = true;
     std::vector<std::pair<std::string, Point<dim>>> labels;
-    bool                                          terminal_test = false;
-    bool                                          write_files   = true;
+    bool                                            terminal_test = false;
+    bool                                            write_files   = true;
   };
 } // namespace knee_contact
 

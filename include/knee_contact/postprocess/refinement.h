@@ -1,9 +1,9 @@
 #ifndef knee_contact_refinement_h
 #define knee_contact_refinement_h
 
-#include <knee_contact/solver/active_set.h>
 #include <knee_contact/contact/contact.h>
 #include <knee_contact/physics/materials.h>
+#include <knee_contact/solver/active_set.h>
 
 #include <deal.II/base/parameter_handler.h>
 

@@ -1,15 +1,15 @@
 #ifndef knee_contact_results_h
 #define knee_contact_results_h
 
-#include <knee_contact/solver/active_set.h>
-#include <knee_contact/physics/boundary_conditions.h>
 #include <knee_contact/contact/contact.h>
+#include <knee_contact/physics/boundary_conditions.h>
 #include <knee_contact/physics/materials.h>
+#include <knee_contact/solver/active_set.h>
+
+#include <deal.II/base/geometry_info.h>
 
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/vector.h>
-
-#include <deal.II/base/geometry_info.h>
 
 #include <deal.II/dofs/dof_handler.h>
 
@@ -34,7 +34,7 @@ namespace knee_contact
     double force = 0;
     /** The force vector on the slave body, -sum lambda_p n_p [N/m]. */
     Tensor<1, dim> force_on_slave;
-    double       max_pressure = 0;
+    double         max_pressure = 0;
     /** Length of slave boundary in contact, sum of the active shares [m]. */
     double contact_length = 0;
   };

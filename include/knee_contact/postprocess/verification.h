@@ -1,10 +1,10 @@
 #ifndef knee_contact_verification_h
 #define knee_contact_verification_h
 
-#include <knee_contact/solver/active_set.h>
 #include <knee_contact/contact/contact.h>
 #include <knee_contact/physics/materials.h>
 #include <knee_contact/postprocess/results.h>
+#include <knee_contact/solver/active_set.h>
 
 #include <deal.II/base/function_parser.h>
 #include <deal.II/base/parameter_handler.h>

@@ -1,9 +1,9 @@
 #ifndef knee_contact_active_set_h
 #define knee_contact_active_set_h
 
+#include <knee_contact/physics/rigid_modes.h>
 #include <knee_contact/solver/contact_row.h>
 #include <knee_contact/solver/contact_system.h>
-#include <knee_contact/physics/rigid_modes.h>
 
 #include <deal.II/base/parameter_handler.h>
 
@@ -12,7 +12,6 @@
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/sparsity_pattern.h>
 #include <deal.II/lac/vector.h>
-
 
 #include <ostream>
 #include <string>
@@ -100,8 +99,8 @@ namespace knee_contact
     solve(ContactSystem                   &system,
           const double                     force_scale,
           const AffineConstraints<double> &base,
-          const std::vector<ContactRow>  &pairs,
-          const RigidModeCheck                &rigid_modes,
+          const std::vector<ContactRow>   &pairs,
+          const RigidModeCheck            &rigid_modes,
           const std::vector<bool>         &guess,
           std::ostream                    &log) const;
 
@@ -112,7 +111,7 @@ namespace knee_contact
     static void
     make_sparsity_pattern(const DynamicSparsityPattern    &mesh_pattern,
                           const AffineConstraints<double> &base,
-                          const std::vector<ContactRow>  &pairs,
+                          const std::vector<ContactRow>   &pairs,
                           SparsityPattern                 &sparsity_pattern);
 
     /**
@@ -120,7 +119,7 @@ namespace knee_contact
      */
     static void
     make_constraints(const AffineConstraints<double> &base,
-                     const std::vector<ContactRow>  &pairs,
+                     const std::vector<ContactRow>   &pairs,
                      const std::vector<bool>         &active,
                      AffineConstraints<double>       &constraints);
 
@@ -132,7 +131,7 @@ namespace knee_contact
     static std::vector<double>
     multipliers(const Vector<double>            &residual,
                 const AffineConstraints<double> &base,
-                const std::vector<ContactRow>  &pairs,
+                const std::vector<ContactRow>   &pairs,
                 const std::vector<bool>         &active);
 
     /**
@@ -145,7 +144,7 @@ namespace knee_contact
                            const Vector<double>            &rhs,
                            const Vector<double>            &x,
                            const AffineConstraints<double> &base,
-                           const std::vector<ContactRow>  &pairs,
+                           const std::vector<ContactRow>   &pairs,
                            const std::vector<bool>         &active,
                            std::vector<double>             &excess,
                            std::vector<double>             &lambda);
@@ -156,7 +155,7 @@ namespace knee_contact
      */
     static double
     displacement_scale(const std::vector<ContactRow> &pairs,
-                       const Vector<double>           &x);
+                       const Vector<double>          &x);
 
   private:
     unsigned int max_iterations  = 50;

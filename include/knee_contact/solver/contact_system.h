@@ -96,7 +96,7 @@ namespace knee_contact
      */
     FullContactSystem(const SparseMatrix<double>      &matrix,
                       const AffineConstraints<double> &base,
-                      const std::vector<ContactRow>  &pairs);
+                      const std::vector<ContactRow>   &pairs);
 
     /** Keeps a reference to @p rhs. */
     void
@@ -117,7 +117,7 @@ namespace knee_contact
     const SparseMatrix<double>      &matrix;
     const Vector<double>            *rhs = nullptr;
     const AffineConstraints<double> &base;
-    const std::vector<ContactRow>  &pairs;
+    const std::vector<ContactRow>   &pairs;
     SparseMatrix<double>             system_matrix;
     Vector<double>                   system_rhs;
     Vector<double>                   x;
@@ -156,7 +156,7 @@ namespace knee_contact
      */
     CondensedContactSystem(const SparseMatrix<double>      &matrix,
                            const AffineConstraints<double> &base,
-                           const std::vector<ContactRow>  &pairs,
+                           const std::vector<ContactRow>   &pairs,
                            const std::vector<int>          &order = {});
     ~CondensedContactSystem() override;
 
@@ -233,7 +233,7 @@ namespace knee_contact
      */
     SparseContactSystem(const SparseMatrix<double>      &matrix,
                         const AffineConstraints<double> &base,
-                        const std::vector<ContactRow>  &pairs);
+                        const std::vector<ContactRow>   &pairs);
     ~SparseContactSystem() override;
 
     void
@@ -305,7 +305,7 @@ namespace knee_contact
   make_contact_system(const SolverPath                 requested,
                       const SparseMatrix<double>      &matrix,
                       const AffineConstraints<double> &base,
-                      const std::vector<ContactRow>  &pairs,
+                      const std::vector<ContactRow>   &pairs,
                       const bool                       warm_start,
                       std::ostream                    &log,
                       std::string                     &name,
@@ -324,7 +324,7 @@ namespace knee_contact
   reference_solve(const SparseMatrix<double>      &matrix,
                   const Vector<double>            &rhs,
                   const AffineConstraints<double> &base,
-                  const std::vector<ContactRow>  &pairs,
+                  const std::vector<ContactRow>   &pairs,
                   const std::vector<bool>         &active,
                   Vector<double>                  &x);
 } // namespace knee_contact

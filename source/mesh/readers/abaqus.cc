@@ -279,7 +279,7 @@ namespace knee_contact
                                   : "name its set in the scene") +
                                ")"));
 
-      Description<2>                       mesh;
+      Description<2>                    mesh;
       std::map<long long, unsigned int> vertex_of_node;
       for (const auto &[id, p] : nodes)
         {

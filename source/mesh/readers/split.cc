@@ -13,7 +13,7 @@ namespace knee_contact
 
     void
     split_into_quadrilaterals(
-      Description<2>                                  &mesh,
+      Description<2>                               &mesh,
       const std::map<types::boundary_id, Point<2>> &circles)
     {
       // Each edge gets one midpoint, shared by the cells beside it, so the

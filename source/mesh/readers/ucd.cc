@@ -48,7 +48,7 @@ namespace knee_contact
       const std::size_t n_nodes = count(header[0], "node count"),
                         n_cells = count(header[1], "cell count");
 
-      Description<2>                       mesh;
+      Description<2>                    mesh;
       std::map<long long, unsigned int> vertex_of_node;
       for (std::size_t i = 0; i < n_nodes; ++i)
         {

@@ -184,7 +184,7 @@ namespace knee_contact
        * (0 1 3 2 round a quadrilateral).
        */
       inline void
-      add_cell(Description<2>              &mesh,
+      add_cell(Description<2>           &mesh,
                std::vector<unsigned int> vertices,
                const types::material_id  material_id)
       {
@@ -197,7 +197,7 @@ namespace knee_contact
       }
 
       inline void
-      add_boundary_line(Description<2>             &mesh,
+      add_boundary_line(Description<2>          &mesh,
                         const unsigned int       a,
                         const unsigned int       b,
                         const types::boundary_id boundary_id)
@@ -208,7 +208,7 @@ namespace knee_contact
         mesh.subcells.boundary_lines.push_back(line);
       }
     } // namespace internal
-  } // namespace mesh_readers
+  }   // namespace mesh_readers
 } // namespace knee_contact
 
 #endif
