@@ -43,7 +43,9 @@ namespace knee_contact
                                 results);
       });
       {
-        TimerOutput::Scope part(timer, "output: cells.npy");
+        TimerOutput::Scope part(timer,
+                                dim == 2 ? "output: cells.npy"
+                                         : "output: surface.npy");
         output_writer.write_cells(dof_handler,
                                   body_of_cell,
                                   displacement,
