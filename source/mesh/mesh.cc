@@ -241,10 +241,10 @@ namespace knee_contact
     unsigned int n_refine = n_refinements;
     if (remeshes(triangulation))
       {
-        if (level == 0 && n_refinements > 0)
+        if (n_refinements > 0)
           {
             triangulation.clear();
-            read_file(triangulation, n_refinements);
+            read_file(triangulation, level + n_refinements);
           }
         n_refine = 0;
       }
