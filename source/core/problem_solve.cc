@@ -100,8 +100,7 @@ namespace knee_contact
         for (unsigned int p = 0; p < contact_pairs.size(); ++p)
           if (contact_solution.active[p])
             previous_contact.emplace_back(contact_pairs.points[p].position,
-                                          std::pow(contact_pairs.rows[p].length,
-                                                   1. / (dim - 1)));
+                                          contact_pairs.rows[p].spacing(dim));
         record.n_cells        = triangulation.n_active_cells();
         record.n_dofs         = dof_handler.n_dofs();
         record.n_pairs        = contact_pairs.size();

@@ -114,8 +114,7 @@ namespace knee_contact
         for (unsigned int p = 0; p < pairs.size(); ++p)
           if (contact.active[p])
             zone.emplace_back(pairs.points[p].position,
-                              2 *
-                                std::pow(pairs.rows[p].length, 1. / (dim - 1)));
+                              2 * pairs.rows[p].spacing(dim));
         for (const auto &cell : triangulation.active_cell_iterators())
           for (const unsigned int v : cell->vertex_indices())
             for (const auto &[centre, radius] : zone)

@@ -5,6 +5,7 @@
 
 #include <deal.II/lac/vector.h>
 
+#include <cmath>
 #include <utility>
 #include <vector>
 
@@ -47,6 +48,16 @@ namespace knee_contact
      */
     types::global_dof_index eliminated       = numbers::invalid_dof_index;
     bool                    slave_eliminated = true;
+
+    /**
+     * The slave vertex's spacing [m] in a mesh of dimension @p dim: the
+     * weight itself in 2D, the square root of the area share in 3D.
+     */
+    double
+    spacing(const unsigned int dim) const
+    {
+      return std::pow(length, 1. / (dim - 1));
+    }
 
     /** a_p . x */
     double
