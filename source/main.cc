@@ -37,10 +37,7 @@ main(int argc, char **argv)
       if (argc == 2 && std::strcmp(argv[1], "--print-parameters") == 0)
         {
           // The 2D scene format; in 3D the vectors have a z component.
-          ParameterHandler prm;
-          ContactProblem<2>::declare_parameters(prm,
-                                                ContactProblem<2>::Counts());
-          prm.print_parameters(std::cout, ParameterHandler::Text);
+          ContactProblem<2>::print_parameters(std::cout);
           return ExitCode::success;
         }
       if (argc == 3 && std::strcmp(argv[1], "--dry-run") == 0)

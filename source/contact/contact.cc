@@ -46,35 +46,44 @@ namespace knee_contact
 
 
   void
-  ContactInterfaces::declare_parameters(ParameterHandler  &prm,
-                                        const unsigned int n_interfaces)
+  ContactInterfaces::add_parameters(ParameterHandler  &prm,
+                                    const unsigned int n_subsections)
   {
     prm.enter_subsection("Contact");
-    prm.declare_entry("Number of interfaces",
-                      "0",
-                      Patterns::Integer(0, 255),
+    prm.add_parameter("Number of interfaces",
+                      n_interfaces,
                       "How many subsections 'Interface 0', 'Interface 1', "
-                      "... follow (the seed's Gamma_c^kl).");
-    for (unsigned int i = 0; i < n_interfaces; ++i)
+                      "... follow (the seed's Gamma_c^kl).",
+                      Patterns::Integer(0, 255));
+    // Bound by reference: the vector is sized once, before binding.
+    list.clear();
+    list.resize(n_subsections);
+    for (unsigned int i = 0; i < n_subsections; ++i)
       {
+        ContactInterface &interface = list[i];
+        interface.name              = "interface " + std::to_string(i);
         prm.enter_subsection("Interface " + std::to_string(i));
-        prm.declare_entry("Name",
-                          "interface " + std::to_string(i),
-                          Patterns::Anything(),
+        prm.add_parameter("Name",
+                          interface.name,
                           "Name used in results and file names.");
-        prm.declare_entry("Slave boundary id",
-                          "0",
-                          Patterns::Integer(0, 254),
+        prm.add_parameter("Slave boundary id",
+                          interface.slave_id,
                           "Boundary id of the side of body k whose vertices "
-                          "are paired (prefer the finer or softer side).");
-        prm.declare_entry("Master boundary id",
-                          "0",
-                          Patterns::Integer(0, 254),
-                          "Boundary id of the side of body l.");
-        prm.declare_entry(
+                          "are paired (prefer the finer or softer side).",
+                          Patterns::Integer(0, 254));
+        prm.add_parameter("Master boundary id",
+                          interface.master_id,
+                          "Boundary id of the side of body l.",
+                          Patterns::Integer(0, 254));
+        std::vector<std::pair<std::string, Pairing>> pairings;
+        for (const Pairing p :
+             {Pairing::mortar, Pairing::node_to_segment, Pairing::node_to_node})
+          pairings.emplace_back(pairing_name(p), p);
+        input::add_selection(
+          prm,
           "Pairing",
-          "mortar",
-          Patterns::Selection("mortar|node-to-segment|node-to-node"),
+          interface.pairing,
+          pairings,
           "mortar: dual mortar (segment-to-segment) conditions, one per "
           "slave vertex, weighted by the biorthogonal multiplier basis; "
           "exact contact pressure for the patch test on non-matching "
@@ -82,11 +91,11 @@ namespace knee_contact
           "paired with the point of the master side along its normal. "
           "node-to-node: the seed's node pairs, every slave vertex must "
           "coincide with a master vertex.");
-        prm.declare_entry("Maximum gap",
-                          "0",
-                          Patterns::Double(0),
+        prm.add_parameter("Maximum gap",
+                          interface.maximum_gap,
                           "Slave vertices farther than this from the master "
-                          "side [m] are not paired; 0: no limit.");
+                          "side [m] are not paired; 0: no limit.",
+                          Patterns::Double(0));
         prm.leave_subsection();
       }
     prm.leave_subsection();
@@ -95,28 +104,13 @@ namespace knee_contact
 
 
   void
-  ContactInterfaces::parse_parameters(ParameterHandler  &prm,
-                                      const unsigned int n_interfaces)
+  ContactInterfaces::check_parameters() const
   {
-    prm.enter_subsection("Contact");
-    for (unsigned int i = 0; i < n_interfaces; ++i)
+    for (unsigned int i = 0; i < list.size(); ++i)
       {
-        prm.enter_subsection("Interface " + std::to_string(i));
-        ContactInterface interface;
-        interface.name = prm.get("Name");
+        const ContactInterface &interface = list[i];
         input::check_name(interface.name,
                           "Contact/Interface " + std::to_string(i) + "/Name");
-        interface.slave_id =
-          static_cast<types::boundary_id>(prm.get_integer("Slave boundary id"));
-        interface.master_id = static_cast<types::boundary_id>(
-          prm.get_integer("Master boundary id"));
-        // The Selection pattern admits exactly the names pairing_name()
-        // gives.
-        for (const Pairing p :
-             {Pairing::mortar, Pairing::node_to_segment, Pairing::node_to_node})
-          if (prm.get("Pairing") == pairing_name(p))
-            interface.pairing = p;
-        interface.maximum_gap = prm.get_double("Maximum gap");
         const std::string where =
           "Contact/Interface " + std::to_string(i) + ": ";
         AssertThrow(interface.slave_id != interface.master_id,
@@ -124,28 +118,27 @@ namespace knee_contact
                                "slave and master boundary ids are "
                                "both " +
                                std::to_string(interface.slave_id)));
-        for (const auto &other : list)
-          AssertThrow(other.name != interface.name &&
-                        csv_file_name(other.name) !=
-                          csv_file_name(interface.name),
-                      ExcMessage(where + "the name '" + interface.name +
-                                 "' is (as a file name, " +
-                                 csv_file_name(interface.name) +
-                                 ") that of interface '" + other.name +
-                                 "' too"));
-        for (const auto &other : list)
-          AssertThrow(other.slave_id != interface.slave_id &&
-                        other.slave_id != interface.master_id &&
-                        other.master_id != interface.slave_id &&
-                        other.master_id != interface.master_id,
-                      ExcMessage(where +
-                                 "shares a boundary id with "
-                                 "interface '" +
-                                 other.name + "'"));
-        list.push_back(interface);
-        prm.leave_subsection();
+        for (unsigned int j = 0; j < i; ++j)
+          {
+            const ContactInterface &other = list[j];
+            AssertThrow(other.name != interface.name &&
+                          csv_file_name(other.name) !=
+                            csv_file_name(interface.name),
+                        ExcMessage(where + "the name '" + interface.name +
+                                   "' is (as a file name, " +
+                                   csv_file_name(interface.name) +
+                                   ") that of interface '" + other.name +
+                                   "' too"));
+            AssertThrow(other.slave_id != interface.slave_id &&
+                          other.slave_id != interface.master_id &&
+                          other.master_id != interface.slave_id &&
+                          other.master_id != interface.master_id,
+                        ExcMessage(where +
+                                   "shares a boundary id with "
+                                   "interface '" +
+                                   other.name + "'"));
+          }
       }
-    prm.leave_subsection();
   }
 
 

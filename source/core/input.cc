@@ -44,38 +44,26 @@ namespace knee_contact
 
 
 
-    std::vector<std::pair<std::string, std::string>>
-    split_named(const std::string &text,
-                const std::string &parameter,
-                const std::string &form)
+    Patterns::List
+    expression_pattern(const unsigned int max_components, const bool optional)
     {
-      std::vector<std::pair<std::string, std::string>> entries;
-      for (const auto &entry : split(text, ';'))
-        if (!entry.empty())
-          {
-            const auto name_value = split(entry, ':');
-            AssertThrow(name_value.size() == 2 && !name_value[0].empty(),
-                        ExcMessage(parameter + ": '" + entry +
-                                   "' is not of the form '" + form + "'"));
-            entries.emplace_back(name_value[0], name_value[1]);
-          }
-      return entries;
+      return Patterns::List(Patterns::Anything(),
+                            optional ? 0 : 1,
+                            max_components,
+                            ";");
     }
 
 
 
-    template <int dim>
-    Point<dim>
-    to_point(const std::string &text, const std::string &parameter)
+    Patterns::List
+    named_list_pattern(const Patterns::PatternBase &value_pattern)
     {
-      const auto xy = split(text, ',');
-      AssertThrow(xy.size() == dim,
-                  ExcMessage(parameter + ": '" + text + "' is not a point " +
-                             (dim == 2 ? "'x, y'" : "'x, y, z'")));
-      Point<dim> p;
-      for (unsigned int d = 0; d < dim; ++d)
-        p[d] = to_double(xy[d], parameter);
-      return p;
+      return Patterns::List(Patterns::Tuple(":",
+                                            Patterns::Anything(),
+                                            value_pattern),
+                            0,
+                            Patterns::List::max_int_value,
+                            ";");
     }
 
 
@@ -312,10 +300,6 @@ namespace knee_contact
         }
     }
 
-    template Point<2>
-    to_point<2>(const std::string &, const std::string &);
-    template Point<3>
-    to_point<3>(const std::string &, const std::string &);
     template std::unique_ptr<FunctionParser<2>>
     parse_expression<2>(const std::string &,
                         const unsigned int,

@@ -15,6 +15,9 @@
 
 #include <deal.II/dofs/dof_tools.h>
 
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -62,6 +65,81 @@ namespace knee_contact
                                  input::one_line(exc.what())));
         }
     }
+
+
+    // The format of every entry by its path ("Mesh/Source"), from deal.II's
+    // Description listing: "set NAME = FORMAT" lines under "subsection"
+    // lines, nested by indentation of two spaces. (Patterns::pattern_factory
+    // would rebuild the patterns from the JSON listing, but deal.II 9.4's
+    // crashes on a list of tuples.)
+    std::map<std::string, std::string>
+    formats(const ParameterHandler &prm)
+    {
+      std::ostringstream listing;
+      prm.print_parameters(listing, ParameterHandler::Description);
+      std::map<std::string, std::string> result;
+      std::vector<std::string>           path;
+      std::istringstream                 in(listing.str());
+      std::string                        line;
+      while (std::getline(in, line))
+        {
+          const std::size_t depth = line.find_first_not_of(' ') / 2;
+          const std::string text  = Utilities::trim(line);
+          if (text.rfind("subsection ", 0) == 0)
+            {
+              path.resize(std::min(depth, path.size()));
+              path.push_back(text.substr(11));
+            }
+          else if (text.rfind("set ", 0) == 0 &&
+                   text.find('=') != std::string::npos)
+            {
+              path.resize(std::min(depth, path.size()));
+              std::string key;
+              for (const auto &section : path)
+                key += section + "/";
+              const std::size_t equal = text.find('=');
+              result[key + Utilities::trim(text.substr(4, equal - 4))] =
+                Utilities::trim(text.substr(equal + 1));
+            }
+        }
+      return result;
+    }
+
+
+
+    // One level of print_parameters()'s listing: entries first, then
+    // subsections, as deal.II's PRM listing orders them.
+    void
+    print_listing(const nlohmann::json                     &node,
+                  const std::string                        &path,
+                  const std::map<std::string, std::string> &formats,
+                  std::ostream                             &out)
+    {
+      const std::string indent((std::count(path.begin(), path.end(), '/')) * 2,
+                               ' ');
+      const auto        comment = [&](const std::string &text) {
+        for (const auto &line :
+             Utilities::break_text_into_lines(text, 76 - indent.size()))
+          out << indent << "# " << line << '\n';
+      };
+      for (const auto &[name, entry] : node.items())
+        if (entry.contains("value"))
+          {
+            comment(entry.at("documentation").get<std::string>());
+            const auto format = formats.find(path + name);
+            if (format != formats.end())
+              comment("Format: " + format->second);
+            out << indent << "set " << name << " = "
+                << entry.at("default_value").get<std::string>() << "\n\n";
+          }
+      for (const auto &[name, section] : node.items())
+        if (!section.contains("value"))
+          {
+            out << indent << "subsection " << name << '\n';
+            print_listing(section, path + name + "/", formats, out);
+            out << indent << "end\n\n";
+          }
+    }
   } // namespace
 
 
@@ -70,38 +148,51 @@ namespace knee_contact
   typename ContactProblem<dim>::Counts
   ContactProblem<dim>::read_counts(const std::string &scene_file)
   {
-    ParameterHandler prm;
-    declare_parameters(prm, Counts{0, 0, 0});
+    ContactProblem<dim> blank;
+    ParameterHandler    prm;
+    blank.add_parameters(prm, Counts{0, 0, 0});
     parse_scene(prm, scene_file, true);
-    Counts counts;
-    prm.enter_subsection("Materials");
-    counts.n_materials = prm.get_integer("Number of materials");
-    prm.leave_subsection();
-    prm.enter_subsection("Boundary conditions");
-    counts.n_conditions = prm.get_integer("Number of conditions");
-    prm.leave_subsection();
-    prm.enter_subsection("Contact");
-    counts.n_interfaces = prm.get_integer("Number of interfaces");
-    prm.leave_subsection();
-    return counts;
+    return Counts{blank.materials.n_materials,
+                  blank.boundary_conditions.n_conditions,
+                  blank.contact_interfaces.n_interfaces};
   }
 
 
 
   template <int dim>
   void
-  ContactProblem<dim>::declare_parameters(ParameterHandler &prm,
-                                          const Counts     &counts)
+  ContactProblem<dim>::print_parameters(std::ostream &out)
   {
-    MeshInput<dim>::declare_parameters(prm);
-    Materials<dim>::declare_parameters(prm, counts.n_materials);
-    BoundaryConditions<dim>::declare_parameters(prm, counts.n_conditions);
-    ContactInterfaces::declare_parameters(prm, counts.n_interfaces);
-    ActiveSetSolver::declare_parameters(prm);
-    LoadCases::declare_parameters(prm);
-    OutputWriter<dim>::declare_parameters(prm);
-    Verification<dim>::declare_parameters(prm);
-    Refinement::declare_parameters(prm);
+    ContactProblem<dim> blank;
+    ParameterHandler    prm;
+    blank.add_parameters(prm, Counts());
+    // deal.II's PRM listing has the defaults and documentation but not the
+    // formats, its Description listing the formats but not the defaults;
+    // its JSON listing has all three, written here as a scene file.
+    std::ostringstream json;
+    prm.print_parameters(json, ParameterHandler::JSON);
+    out << "# Every parameter of a scene: its documentation, its format and "
+           "its default\n# (2D; in 3D vectors and points have a z "
+           "component).\n";
+    print_listing(nlohmann::json::parse(json.str()), "", formats(prm), out);
+  }
+
+
+
+  template <int dim>
+  void
+  ContactProblem<dim>::add_parameters(ParameterHandler &prm,
+                                      const Counts     &counts)
+  {
+    mesh_input.add_parameters(prm);
+    materials.add_parameters(prm, counts.n_materials);
+    boundary_conditions.add_parameters(prm, counts.n_conditions);
+    contact_interfaces.add_parameters(prm, counts.n_interfaces);
+    active_set_solver.add_parameters(prm);
+    load_cases.add_parameters(prm);
+    output_writer.add_parameters(prm);
+    verification.add_parameters(prm);
+    refinement.add_parameters(prm);
   }
 
 
@@ -124,19 +215,22 @@ namespace knee_contact
                            "Interface",
                            counts.n_interfaces,
                            "Number of interfaces");
+    // Each entry is bound to the member it sets (add_parameter): parsing
+    // fills them and refuses a value that does not match its pattern, with
+    // the file and line; the checks that patterns cannot make follow.
     ParameterHandler prm;
-    declare_parameters(prm, counts);
+    add_parameters(prm, counts);
     parse_scene(prm, scene_file, false);
 
-    mesh_input.parse_parameters(prm, scene_file);
-    materials.parse_parameters(prm, counts.n_materials);
-    boundary_conditions.parse_parameters(prm, counts.n_conditions);
-    contact_interfaces.parse_parameters(prm, counts.n_interfaces);
-    active_set_solver.parse_parameters(prm, materials.max_youngs_modulus());
-    load_cases.parse_parameters(prm);
-    output_writer.parse_parameters(prm, scene_file);
-    verification.parse_parameters(prm);
-    refinement.parse_parameters(prm);
+    mesh_input.check_parameters(scene_file);
+    materials.check_parameters();
+    boundary_conditions.check_parameters();
+    contact_interfaces.check_parameters();
+    active_set_solver.check_parameters(materials.max_youngs_modulus());
+    load_cases.check_parameters();
+    output_writer.check_parameters(scene_file);
+    verification.check_parameters();
+    refinement.check_parameters();
     mesh_input.adaptive = refinement.strategy != Refinement::Strategy::global;
     scene_checks::check_roles(boundary_conditions, contact_interfaces);
     AssertThrow(dim == 2 || contact_interfaces.interfaces().empty(),
@@ -310,9 +404,10 @@ namespace knee_contact
   scene_dimension(const std::string &scene_file)
   {
     ParameterHandler prm;
-    MeshInput<2>::declare_parameters(prm);
+    MeshInput<2>     mesh_input;
+    mesh_input.add_parameters(prm);
     parse_scene(prm, scene_file, true);
-    return scene_dimension(prm, scene_file);
+    return scene_dimension(mesh_input, scene_file);
   }
 
 

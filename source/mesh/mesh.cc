@@ -24,102 +24,127 @@ namespace knee_contact
 {
   template <int dim>
   void
-  MeshInput<dim>::declare_parameters(ParameterHandler &prm)
+  MeshInput<dim>::add_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Mesh");
-    prm.declare_entry("Source",
-                      "rectangles",
-                      Patterns::Selection("rectangles|file"),
-                      "Where the mesh comes from: 'file' (Gmsh .msh or .geo, "
-                      "Abaqus .inp, legacy VTK .vtk) or 'rectangles' (built "
-                      "in, for simple scenes and tests).");
-    prm.declare_entry("File",
-                      "",
-                      Patterns::Anything(),
-                      "Mesh file, relative to the scene file, read by its "
-                      "extension: .msh (Gmsh 2.2 or 4.1 ASCII) or .geo "
-                      "(meshed by the gmsh program): in 2D physical surfaces "
-                      "become material ids, physical curves boundary ids; "
-                      "a mesh with tetrahedra or hexahedra is solved in 3D, "
-                      "with physical volumes as material ids and physical "
-                      "surfaces as boundary ids. 2D only: .inp (Abaqus input "
-                      "deck): see Abaqus element sets and Abaqus boundary "
-                      "sets; .vtk (legacy ASCII VTK) and .vtu (VTK XML), "
-                      "unstructured grids: the cell field MaterialID gives "
-                      "material ids, and of line cells boundary ids; .ucd "
-                      "(AVS UCD). 2D cells are triangles, quadrilaterals or "
-                      "both.");
-    prm.declare_entry("Triangles",
-                      "P1",
-                      Patterns::Selection("P1|quadrilaterals"),
-                      "How a mesh of triangles is solved: 'P1' (the seed's "
-                      "linear triangles) or 'quadrilaterals' (each triangle "
-                      "split at its centroid into three quadrilaterals, "
-                      "solved with Q1). A mesh of triangles and "
-                      "quadrilaterals is always split (every triangle into "
-                      "three, every quadrilateral into four), and so is a "
-                      "triangle mesh refined adaptively: deal.II 9.4 cannot "
-                      "do these with triangles (see the README).");
-    prm.declare_entry("Abaqus element sets",
-                      "",
-                      Patterns::Anything(),
-                      "For an .inp file: 'NAME: material id; ...', the "
-                      "element sets (*Elset, or ELSET= of *Element) that "
-                      "make the materials. Empty: the element sets of the "
-                      "*Solid Section lines get material ids 1, 2, ... in "
-                      "file order.");
-    prm.declare_entry("Abaqus boundary sets",
-                      "",
-                      Patterns::Anything(),
-                      "For an .inp file: 'NAME: boundary id; ...', surfaces "
-                      "(*Surface, element faces S1-S4) or node sets (*Nset: "
-                      "the boundary edges whose two nodes are in the set) "
-                      "that the boundary conditions and contact interfaces "
-                      "name by id.");
-    prm.declare_entry("Gmsh arguments",
-                      "",
-                      Patterns::Anything(),
-                      "Extra arguments for the gmsh program when File is a "
-                      ".geo, e.g. '-setnumber lc 0.002' or '-clscale 0.5': "
-                      "words, never a command line; only -setnumber NAME "
-                      "NUMBER, -clscale, -clmin, -clmax, -clcurv and -smooth "
-                      "NUMBER are accepted.");
-    prm.declare_entry("Gmsh time limit",
-                      "300",
-                      Patterns::Double(1),
+    input::add_selection(
+      prm,
+      "Source",
+      source,
+      {{"rectangles", Source::rectangles}, {"file", Source::file}},
+      "Where the mesh comes from: 'file' (Gmsh .msh or .geo, Abaqus .inp, "
+      "legacy VTK .vtk) or 'rectangles' (built in, for simple scenes and "
+      "tests).");
+    prm.add_parameter(
+      "File",
+      entries.file,
+      "Mesh file, relative to the scene file, read by its extension: .msh "
+      "(Gmsh 2.2 or 4.1 ASCII) or .geo (meshed by the gmsh program): in 2D "
+      "physical surfaces become material ids, physical curves boundary ids; "
+      "a mesh with tetrahedra or hexahedra is solved in 3D, with physical "
+      "volumes as material ids and physical surfaces as boundary ids. 2D "
+      "only: .inp (Abaqus input deck): see Abaqus element sets and Abaqus "
+      "boundary sets; .vtk (legacy ASCII VTK) and .vtu (VTK XML), "
+      "unstructured grids: the cell field MaterialID gives material ids, and "
+      "of line cells boundary ids; .ucd (AVS UCD). 2D cells are triangles, "
+      "quadrilaterals or both.",
+      Patterns::FileName());
+    input::add_selection(
+      prm,
+      "Triangles",
+      split_triangles,
+      {{"P1", false}, {"quadrilaterals", true}},
+      "How a mesh of triangles is solved: 'P1' (the seed's linear "
+      "triangles) or 'quadrilaterals' (each triangle split at its centroid "
+      "into three quadrilaterals, solved with Q1). A mesh of triangles and "
+      "quadrilaterals is always split (every triangle into three, every "
+      "quadrilateral into four), and so is a triangle mesh refined "
+      "adaptively: deal.II 9.4 cannot do these with triangles (see the "
+      "README).");
+    prm.add_parameter(
+      "Abaqus element sets",
+      entries.abaqus_element_sets,
+      "For an .inp file: 'NAME: material id; ...', the element sets "
+      "(*Elset, or ELSET= of *Element) that make the materials. Empty: the "
+      "element sets of the *Solid Section lines get material ids 1, 2, ... "
+      "in file order.",
+      input::named_list_pattern(Patterns::Integer(0, 254)));
+    prm.add_parameter(
+      "Abaqus boundary sets",
+      entries.abaqus_boundary_sets,
+      "For an .inp file: 'NAME: boundary id; ...', surfaces (*Surface, "
+      "element faces S1-S4) or node sets (*Nset: the boundary edges whose "
+      "two nodes are in the set) that the boundary conditions and contact "
+      "interfaces name by id.",
+      input::named_list_pattern(Patterns::Integer(0, 254)));
+    prm.add_parameter(
+      "Gmsh arguments",
+      entries.gmsh_arguments,
+      "Extra arguments for the gmsh program when File is a .geo, e.g. "
+      "'-setnumber lc 0.002' or '-clscale 0.5': words, never a command line; "
+      "only -setnumber NAME NUMBER, -clscale, -clmin, -clmax, -clcurv and "
+      "-smooth NUMBER are accepted.");
+    prm.add_parameter("Gmsh time limit",
+                      gmsh_time_limit,
                       "Seconds gmsh may take to mesh a .geo before it is "
-                      "stopped and the run refused [s].");
-    prm.declare_entry(
+                      "stopped and the run refused [s].",
+                      Patterns::Double(1));
+    // x0, y0, x1, y1 [m], n_x, n_y, material id, group, and the boundary ids
+    // of the left, right, bottom and top sides.
+    const Patterns::Integer id(0, 254), count(1, 99999);
+    prm.add_parameter(
       "Rectangles",
-      "0, 0, 1, 1, 1, 1, 1, 0, 1, 2, 3, 4",
-      Patterns::Anything(),
+      entries.rectangles,
       "For Source = rectangles: rectangles separated by ';', each 'x0, y0, "
       "x1, y1, n_x, n_y, material id, group, left id, right id, bottom id, "
       "top id' (lengths in m). Rectangles of the same group share vertices "
-      "where they meet (bonded); different groups never do (contact).");
-    prm.declare_entry("Rectangle cells",
-                      "quadrilaterals",
-                      Patterns::Selection("quadrilaterals|triangles|mixed"),
-                      "For Source = rectangles: the cells of each grid "
-                      "cell: one quadrilateral, two triangles (cut from "
-                      "lower left to upper right), or mixed (a checkerboard "
-                      "of both).");
-    prm.declare_entry("Rotation angle",
-                      "0",
-                      Patterns::Double(),
+      "where they meet (bonded); different groups never do (contact).",
+      Patterns::List(Patterns::Tuple(",",
+                                     Patterns::Double(),
+                                     Patterns::Double(),
+                                     Patterns::Double(),
+                                     Patterns::Double(),
+                                     count,
+                                     count,
+                                     id,
+                                     Patterns::Integer(0, 99999),
+                                     id,
+                                     id,
+                                     id,
+                                     id),
+                     0,
+                     Patterns::List::max_int_value,
+                     ";"));
+    input::add_selection(
+      prm,
+      "Rectangle cells",
+      rectangle_cells,
+      {{"quadrilaterals", RectangleCells::quadrilaterals},
+       {"triangles", RectangleCells::triangles},
+       {"mixed", RectangleCells::mixed}},
+      "For Source = rectangles: the cells of each grid cell: one "
+      "quadrilateral, two triangles (cut from lower left to upper right), or "
+      "mixed (a checkerboard of both).");
+    prm.add_parameter("Rotation angle",
+                      rotation_degrees,
                       "Rotate the whole mesh about the origin by this angle "
-                      "[degrees, counter-clockwise].");
-    prm.declare_entry("Global refinements",
-                      "0",
-                      Patterns::Integer(0, 12),
-                      "Refine every cell this many times after reading.");
-    prm.declare_entry("Circular boundaries",
-                      "",
-                      Patterns::Anything(),
-                      "Boundary ids that are circular arcs, so refinement "
-                      "places new vertices on the circle: 'id: x_c, y_c; ...' "
-                      "with the centre (x_c, y_c) [m]; in 3D spheres, "
-                      "'id: x_c, y_c, z_c; ...'.");
+                      "[degrees, counter-clockwise].",
+                      Patterns::Double());
+    prm.add_parameter("Global refinements",
+                      n_refinements,
+                      "Refine every cell this many times after reading.",
+                      Patterns::Integer(0, 12));
+    prm.add_parameter(
+      "Circular boundaries",
+      entries.circular_boundaries,
+      "Boundary ids that are circular arcs, so refinement places new "
+      "vertices on the circle: 'id: x_c, y_c; ...' with the centre (x_c, "
+      "y_c) [m]; in 3D spheres, 'id: x_c, y_c, z_c; ...'.",
+      Patterns::List(
+        Patterns::Tuple(":", id, Patterns::List(Patterns::Double(), 2, 3, ",")),
+        0,
+        Patterns::List::max_int_value,
+        ";"));
     prm.leave_subsection();
   }
 
@@ -127,48 +152,33 @@ namespace knee_contact
 
   template <int dim>
   void
-  MeshInput<dim>::parse_parameters(ParameterHandler  &prm,
-                                   const std::string &scene_file)
+  MeshInput<dim>::check_parameters(const std::string &scene_file)
   {
-    prm.enter_subsection("Mesh");
-    source = prm.get("Source") == "file" ? Source::file : Source::rectangles;
-    file   = input::resolve_path(prm.get("File"), scene_file);
-    gmsh_arguments  = gmsh_input::arguments(prm.get("Gmsh arguments"));
-    gmsh_time_limit = prm.get_double("Gmsh time limit");
-    split_triangles = prm.get("Triangles") == "quadrilaterals";
-    rectangle_cells =
-      prm.get("Rectangle cells") == "triangles" ? RectangleCells::triangles
-      : prm.get("Rectangle cells") == "mixed"   ? RectangleCells::mixed
-                                              : RectangleCells::quadrilaterals;
-    const auto read_sets = [](const std::string                   &text,
-                              const std::string                   &parameter,
-                              std::map<std::string, unsigned int> &sets) {
-      for (const auto &[set, id_text] :
-           input::split_named(text, parameter, "NAME: id"))
-        {
-          const double id = input::to_double(id_text, parameter);
-          AssertThrow(id >= 0 && id < 255 && id == std::floor(id),
-                      ExcMessage(parameter + ": '" + id_text + "' for set '" +
-                                 set + "' is not an id in 0..254"));
-          AssertThrow(sets.emplace(set, static_cast<unsigned int>(id)).second,
-                      ExcMessage(parameter + ": set '" + set +
-                                 "' is named twice"));
-        }
-    };
-    read_sets(prm.get("Abaqus element sets"),
+    file           = input::resolve_path(entries.file, scene_file);
+    gmsh_arguments = gmsh_input::arguments(entries.gmsh_arguments);
+    const auto read_sets =
+      [](const std::vector<std::pair<std::string, unsigned int>> &entry,
+         const std::string                                       &parameter,
+         std::map<std::string, unsigned int>                     &sets) {
+        for (const auto &[set, id] : entry)
+          {
+            AssertThrow(!set.empty(),
+                        ExcMessage(parameter + ": a set without a name"));
+            AssertThrow(sets.emplace(set, id).second,
+                        ExcMessage(parameter + ": set '" + set +
+                                   "' is named twice"));
+          }
+      };
+    read_sets(entries.abaqus_element_sets,
               "Mesh/Abaqus element sets",
               abaqus_element_sets);
-    read_sets(prm.get("Abaqus boundary sets"),
+    read_sets(entries.abaqus_boundary_sets,
               "Mesh/Abaqus boundary sets",
               abaqus_boundary_sets);
-    rotation_degrees = prm.get_double("Rotation angle");
-    n_refinements    = prm.get_integer("Global refinements");
-    AssertThrow(std::isfinite(rotation_degrees),
-                ExcMessage("Mesh/Rotation angle is not a finite number"));
 
     if (source == Source::file)
       {
-        AssertThrow(!prm.get("File").empty(),
+        AssertThrow(!entries.file.empty(),
                     ExcMessage("Mesh/File: no file given for Source = file"));
         AssertThrow(std::ifstream(file).good(),
                     ExcMessage("Mesh/File: cannot open '" + file + "'"));
@@ -178,50 +188,42 @@ namespace knee_contact
                                "' is not a file (a folder?)"));
       }
     else
-      for (const auto &text : input::split(prm.get("Rectangles"), ';'))
+      for (const auto &entry : entries.rectangles)
         {
-          const auto v = input::split(text, ',');
-          AssertThrow(v.size() == 12,
-                      ExcMessage("Mesh/Rectangles: '" + text +
-                                 "' does not have 12 numbers"));
-          std::array<double, 12> n;
-          for (unsigned int i = 0; i < 12; ++i)
-            n[i] = input::to_double(v[i], "Mesh/Rectangles");
-          for (unsigned int i = 4; i < 12; ++i)
-            AssertThrow(n[i] >= 0 && n[i] == std::floor(n[i]) &&
-                          n[i] < (i < 6 ? 1e5 : 255),
-                        ExcMessage("Mesh/Rectangles: '" + v[i] + "' in '" +
-                                   text + "' must be a non-negative integer"));
           Rectangle r;
-          r.lower = Point<2>(n[0], n[1]);
-          r.upper = Point<2>(n[2], n[3]);
+          r.lower = Point<2>(std::get<0>(entry), std::get<1>(entry));
+          r.upper = Point<2>(std::get<2>(entry), std::get<3>(entry));
           AssertThrow(r.upper[0] > r.lower[0] && r.upper[1] > r.lower[1],
-                      ExcMessage("Mesh/Rectangles: '" + text +
-                                 "' needs x1 > x0 and y1 > y0"));
-          r.n_x         = static_cast<unsigned int>(n[4]);
-          r.n_y         = static_cast<unsigned int>(n[5]);
-          r.material_id = static_cast<types::material_id>(n[6]);
-          r.group       = static_cast<unsigned int>(n[7]);
-          AssertThrow(r.n_x > 0 && r.n_y > 0,
-                      ExcMessage("Mesh/Rectangles: '" + text +
-                                 "' needs n_x, n_y >= 1"));
-          for (unsigned int i = 0; i < 4; ++i)
-            r.boundary_ids[i] = static_cast<types::boundary_id>(n[8 + i]);
+                      ExcMessage("Mesh/Rectangles: a rectangle from (" +
+                                 std::to_string(r.lower[0]) + ", " +
+                                 std::to_string(r.lower[1]) + ") to (" +
+                                 std::to_string(r.upper[0]) + ", " +
+                                 std::to_string(r.upper[1]) +
+                                 ") needs x1 > x0 and y1 > y0"));
+          r.n_x          = std::get<4>(entry);
+          r.n_y          = std::get<5>(entry);
+          r.material_id  = static_cast<types::material_id>(std::get<6>(entry));
+          r.group        = std::get<7>(entry);
+          r.boundary_ids = {{std::get<8>(entry),
+                             std::get<9>(entry),
+                             std::get<10>(entry),
+                             std::get<11>(entry)}};
           rectangles.push_back(r);
         }
 
-    const std::string circles = "Mesh/Circular boundaries";
-    for (const auto &[id_text, centre] : input::split_named(
-           prm.get("Circular boundaries"), circles, "id: x_c, y_c"))
+    for (const auto &[id, centre] : entries.circular_boundaries)
       {
-        const double id = input::to_double(id_text, circles);
-        AssertThrow(id >= 0 && id < 255 && id == std::floor(id),
-                    ExcMessage(circles + ": '" + id_text +
-                               "' is not a boundary id"));
-        circular_boundaries[static_cast<types::boundary_id>(id)] =
-          input::to_point<dim>(centre, circles);
+        AssertThrow(centre.size() == dim,
+                    ExcMessage("Mesh/Circular boundaries: the centre of "
+                               "boundary id " +
+                               std::to_string(id) + " needs " +
+                               (dim == 2 ? "x, y (the mesh is 2D)"
+                                         : "x, y, z (the mesh is 3D)")));
+        Point<dim> c;
+        for (unsigned int d = 0; d < dim; ++d)
+          c[d] = centre[d];
+        circular_boundaries[static_cast<types::boundary_id>(id)] = c;
       }
-    prm.leave_subsection();
   }
 
 

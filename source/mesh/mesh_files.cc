@@ -105,15 +105,15 @@ namespace knee_contact
 
 
   unsigned int
-  scene_dimension(ParameterHandler &prm, const std::string &scene_file)
+  scene_dimension(const MeshInput<2> &mesh_input, const std::string &scene_file)
   {
-    prm.enter_subsection("Mesh");
-    const bool        from_file = prm.get("Source") == "file";
-    const std::string file  = input::resolve_path(prm.get("File"), scene_file);
-    const auto   arguments  = gmsh_input::arguments(prm.get("Gmsh arguments"));
-    const double time_limit = prm.get_double("Gmsh time limit");
-    prm.leave_subsection();
-    const auto extension = std::filesystem::path(file).extension();
+    const bool from_file = mesh_input.source == MeshInput<2>::Source::file;
+    const std::string file =
+      input::resolve_path(mesh_input.entries.file, scene_file);
+    const auto arguments =
+      gmsh_input::arguments(mesh_input.entries.gmsh_arguments);
+    const double time_limit = mesh_input.gmsh_time_limit;
+    const auto   extension  = std::filesystem::path(file).extension();
     // Anything else is 2D; a missing file is reported by MeshInput.
     if (!from_file || (extension != ".msh" && extension != ".geo") ||
         !std::filesystem::is_regular_file(file) || !std::ifstream(file).good())

@@ -7,50 +7,61 @@
 #include <deal.II/numerics/vector_tools.h>
 
 #include <cmath>
+#include <map>
 
 namespace knee_contact
 {
   template <int dim>
   void
-  BoundaryConditions<dim>::declare_parameters(ParameterHandler  &prm,
-                                              const unsigned int n_conditions)
+  BoundaryConditions<dim>::add_parameters(ParameterHandler  &prm,
+                                          const unsigned int n_subsections)
   {
     prm.enter_subsection("Boundary conditions");
-    prm.declare_entry("Number of conditions",
-                      "0",
-                      Patterns::Integer(0, 255),
+    prm.add_parameter("Number of conditions",
+                      n_conditions,
                       "How many subsections 'Condition 0', 'Condition 1', "
                       "... follow. Boundaries without a condition are free "
-                      "(P = 0).");
-    for (unsigned int c = 0; c < n_conditions; ++c)
+                      "(P = 0).",
+                      Patterns::Integer(0, 255));
+    // Bound by reference: the vector is sized once, before binding.
+    entries.clear();
+    entries.resize(n_subsections);
+    for (unsigned int c = 0; c < n_subsections; ++c)
       {
+        Entry &entry = entries[c];
         prm.enter_subsection("Condition " + std::to_string(c));
-        prm.declare_entry("Boundary ids",
-                          "",
-                          Patterns::List(Patterns::Integer(0, 254)),
+        prm.add_parameter("Boundary ids",
+                          entry.ids,
                           "Boundary ids (Gmsh: tags of physical curves in "
                           "2D, physical surfaces in 3D) this condition "
-                          "applies to.");
-        prm.declare_entry(
+                          "applies to.",
+                          Patterns::List(Patterns::Integer(0, 254)));
+        input::add_selection(
+          prm,
           "Type",
-          "displacement",
-          Patterns::Selection("displacement|traction|pressure|sliding"),
+          entry.type,
+          {{"displacement", BoundaryType::displacement},
+           {"traction", BoundaryType::traction},
+           {"pressure", BoundaryType::pressure},
+           {"sliding", BoundaryType::sliding}},
           "displacement: u = u0 on Gamma_u; traction: tau.n = P on "
           "Gamma_tau; pressure: tau.n = -p n (p > 0 pushes into the body); "
           "sliding: u.n = 0 and zero tangential traction on Gamma_o.");
-        prm.declare_entry("Components",
-                          dim == 2 ? "x, y" : "x, y, z",
-                          Patterns::MultipleSelection(dim == 2 ? "x|y"
-                                                               : "x|y|z"),
+        prm.add_parameter("Components",
+                          entry.components,
                           "For displacement: the components of u0 that are "
-                          "prescribed; the others stay free.");
-        prm.declare_entry("Value",
-                          dim == 2 ? "0; 0" : "0; 0; 0",
-                          Patterns::Anything(),
+                          "prescribed; the others stay free.",
+                          Patterns::List(Patterns::Selection(
+                                           dim == 2 ? "x|y" : "x|y|z"),
+                                         0,
+                                         dim));
+        prm.add_parameter("Value",
+                          entry.value,
                           "Expression in x, y [m]: u0 = (u_x; u_y) [m] for "
                           "displacement, P = (P_x; P_y) [Pa] for traction, "
                           "p [Pa] for pressure; unused for sliding. In 3D "
-                          "three components in x, y, z.");
+                          "three components in x, y, z.",
+                          input::expression_pattern(3));
         prm.leave_subsection();
       }
     prm.leave_subsection();
@@ -60,40 +71,32 @@ namespace knee_contact
 
   template <int dim>
   void
-  BoundaryConditions<dim>::parse_parameters(ParameterHandler  &prm,
-                                            const unsigned int n_conditions)
+  BoundaryConditions<dim>::check_parameters()
   {
-    prm.enter_subsection("Boundary conditions");
     std::map<types::boundary_id, std::string> used;
-    for (unsigned int c = 0; c < n_conditions; ++c)
+    for (unsigned int c = 0; c < entries.size(); ++c)
       {
+        const Entry           &entry = entries[c];
         BoundaryCondition<dim> condition;
         condition.name = "Boundary conditions/Condition " + std::to_string(c);
-        prm.enter_subsection("Condition " + std::to_string(c));
-        const std::string type = prm.get("Type");
-        condition.type = type == "displacement" ? BoundaryType::displacement
-                         : type == "traction"   ? BoundaryType::traction
-                         : type == "pressure"   ? BoundaryType::pressure
-                                                : BoundaryType::sliding;
-        for (const auto &id :
-             Utilities::split_string_list(prm.get("Boundary ids")))
+        condition.type = entry.type;
+        for (const unsigned int id : entry.ids)
           {
-            const auto b = static_cast<types::boundary_id>(std::stoi(id));
+            const auto b = static_cast<types::boundary_id>(id);
             AssertThrow(used.find(b) == used.end(),
                         ExcMessage(condition.name +
                                    "/Boundary ids: boundary "
                                    "id " +
-                                   id + " already has a condition in " +
-                                   used[b]));
+                                   std::to_string(id) +
+                                   " already has a condition in " + used[b]));
             used[b] = condition.name;
             condition.ids.insert(b);
           }
         AssertThrow(!condition.ids.empty(),
                     ExcMessage(condition.name + "/Boundary ids: empty list"));
-        const std::string components = prm.get("Components");
         std::vector<bool> selected(dim);
-        for (unsigned int d = 0; d < dim; ++d)
-          selected[d] = components.find("xyz"[d]) != std::string::npos;
+        for (const auto &component : entry.components)
+          selected[component[0] - 'x'] = true;
         condition.mask = ComponentMask(selected);
         AssertThrow(condition.type != BoundaryType::displacement ||
                       condition.mask.n_selected_components() > 0,
@@ -101,15 +104,13 @@ namespace knee_contact
                                "/Components: no component selected"));
         if (condition.type != BoundaryType::sliding)
           condition.function = input::parse_expression<dim>(
-            prm.get("Value"),
+            entry.value,
             condition.type == BoundaryType::pressure ? 1 : dim,
             condition.name + "/Value",
             "",
             condition.type != BoundaryType::displacement);
-        prm.leave_subsection();
         list.push_back(std::move(condition));
       }
-    prm.leave_subsection();
   }
 
 

@@ -51,54 +51,59 @@ namespace knee_contact
 
   template <int dim>
   void
-  Materials<dim>::declare_parameters(ParameterHandler  &prm,
-                                     const unsigned int n_materials)
+  Materials<dim>::add_parameters(ParameterHandler  &prm,
+                                 const unsigned int n_subsections)
   {
     prm.enter_subsection("Materials");
-    prm.declare_entry("Number of materials",
-                      "1",
-                      Patterns::Integer(1, 255),
+    prm.add_parameter("Number of materials",
+                      n_materials,
                       "How many subsections 'Material 0', 'Material 1', ... "
-                      "follow.");
-    prm.declare_entry("Plane",
-                      "strain",
-                      Patterns::Selection("strain|stress"),
-                      "2D model: plane strain (e_zz = 0, the default) or "
-                      "plane stress (tau_zz = 0); unused in 3D.");
-    for (unsigned int m = 0; m < n_materials; ++m)
+                      "follow.",
+                      Patterns::Integer(1, 255));
+    input::add_selection(prm,
+                         "Plane",
+                         plane_strain,
+                         {{"strain", true}, {"stress", false}},
+                         "2D model: plane strain (e_zz = 0, the default) or "
+                         "plane stress (tau_zz = 0); unused in 3D.");
+    // Bound by reference: the vector is sized once, before binding.
+    entries.clear();
+    entries.resize(n_subsections);
+    for (unsigned int m = 0; m < n_subsections; ++m)
       {
+        Entry &entry      = entries[m];
+        entry.material_id = m + 1;
+        entry.name        = "material " + std::to_string(m + 1);
         prm.enter_subsection("Material " + std::to_string(m));
-        prm.declare_entry("Material id",
-                          std::to_string(m + 1),
-                          Patterns::Integer(0, 254),
+        prm.add_parameter("Material id",
+                          entry.material_id,
                           "Material id of the cells (Gmsh: the tag of the "
-                          "physical surface in 2D, physical volume in 3D).");
-        prm.declare_entry("Name",
-                          "material " + std::to_string(m + 1),
-                          Patterns::Anything(),
-                          "Name shown in results.");
-        prm.declare_entry("Young's modulus",
-                          "1e9",
-                          Patterns::Double(),
-                          "Young's modulus E [Pa], > 0.");
-        prm.declare_entry("Poisson's ratio",
-                          "0.3",
-                          Patterns::Double(),
-                          "Poisson's ratio nu, in (-1, 0.5).");
-        prm.declare_entry("Volumetric integration",
-                          "full",
-                          Patterns::Selection("full|reduced"),
-                          "full: 2 Gauss points per direction for the whole "
-                          "stiffness; "
-                          "reduced: the volumetric part lambda div u div v "
-                          "with one point (selective reduced integration), "
-                          "against locking when nu is close to 0.5.");
-        prm.declare_entry("Body force",
-                          dim == 2 ? "0; 0" : "0; 0; 0",
-                          Patterns::Anything(),
+                          "physical surface in 2D, physical volume in 3D).",
+                          Patterns::Integer(0, 254));
+        prm.add_parameter("Name", entry.name, "Name shown in results.");
+        prm.add_parameter("Young's modulus",
+                          entry.youngs_modulus,
+                          "Young's modulus E [Pa], in [1e-20, 1e30].",
+                          Patterns::Double());
+        prm.add_parameter("Poisson's ratio",
+                          entry.poissons_ratio,
+                          "Poisson's ratio nu, in (-1, 0.5).",
+                          Patterns::Double());
+        input::add_selection(
+          prm,
+          "Volumetric integration",
+          entry.reduced_volumetric,
+          {{"full", false}, {"reduced", true}},
+          "full: 2 Gauss points per direction for the whole stiffness; "
+          "reduced: the volumetric part lambda div u div v with one point "
+          "(selective reduced integration), against locking when nu is "
+          "close to 0.5.");
+        prm.add_parameter("Body force",
+                          entry.body_force,
                           "Body force F = (F_x; F_y) [N/m^3] of the seed's "
-                          "eq. (1), an expression in x, y [m]; in 3D "
-                          "(F_x; F_y; F_z) in x, y, z.");
+                          "eq. (1), an expression in x, y [m]; in 3D (F_x; "
+                          "F_y; F_z) in x, y, z.",
+                          input::expression_pattern(3));
         prm.leave_subsection();
       }
     prm.leave_subsection();
@@ -108,71 +113,66 @@ namespace knee_contact
 
   template <int dim>
   void
-  Materials<dim>::parse_parameters(ParameterHandler  &prm,
-                                   const unsigned int n_materials)
+  Materials<dim>::check_parameters()
   {
-    prm.enter_subsection("Materials");
-    const bool plane_strain = prm.get("Plane") == "strain";
-    for (unsigned int m = 0; m < n_materials; ++m)
+    for (unsigned int m = 0; m < entries.size(); ++m)
       {
+        const Entry      &entry   = entries[m];
         const std::string section = "Material " + std::to_string(m);
-        prm.enter_subsection(section);
-        const auto id =
-          static_cast<types::material_id>(prm.get_integer("Material id"));
+        const auto id = static_cast<types::material_id>(entry.material_id);
         AssertThrow(materials.find(id) == materials.end(),
                     ExcMessage("Materials/" + section + ": material id " +
                                std::to_string(id) +
                                " is given to more than one material"));
         Material<dim> &material = materials[id];
-        material.name           = prm.get("Name");
+        material.name           = entry.name;
         input::check_name(material.name, "Materials/" + section + "/Name");
         for (const auto &[other_id, other] : materials)
           AssertThrow(other_id == id || other.name != material.name,
                       ExcMessage("Materials/" + section + "/Name: '" +
                                  material.name +
                                  "' is the name of another material too"));
-        material.youngs_modulus = prm.get_double("Young's modulus");
-        material.poissons_ratio = prm.get_double("Poisson's ratio");
-        material.plane_strain   = plane_strain;
-        material.reduced_volumetric =
-          prm.get("Volumetric integration") == "reduced";
-        const double E  = material.youngs_modulus;
-        const double nu = material.poissons_ratio;
+        material.youngs_modulus     = entry.youngs_modulus;
+        material.poissons_ratio     = entry.poissons_ratio;
+        material.plane_strain       = plane_strain;
+        material.reduced_volumetric = entry.reduced_volumetric;
+        const double       E        = material.youngs_modulus;
+        const double       nu       = material.poissons_ratio;
+        std::ostringstream E_text, nu_text;
+        E_text << E;
+        nu_text << nu;
         AssertThrow(std::isfinite(E) && E > 0,
                     ExcMessage("Materials/" + section +
                                "/Young's modulus: E must be > 0, got " +
-                               prm.get("Young's modulus")));
+                               E_text.str()));
         // Beyond these the stiffness or the displacement leaves the range
         // of double precision (E = 1e-300 gives an infinite energy).
         AssertThrow(E >= 1e-20 && E <= 1e30,
-                    ExcMessage(
-                      "Materials/" + section +
-                      "/Young's modulus: E = " + prm.get("Young's modulus") +
-                      " is outside [1e-20, 1e30] (choose units "
-                      "that keep E and the loads near 1)"));
+                    ExcMessage("Materials/" + section +
+                               "/Young's modulus: E = " + E_text.str() +
+                               " is outside [1e-20, 1e30] (choose units "
+                               "that keep E and the loads near 1)"));
         AssertThrow(std::isfinite(nu) && nu > -1 && nu < 0.5,
                     ExcMessage("Materials/" + section +
                                "/Poisson's ratio: nu must lie in (-1, 0.5), "
                                "got " +
-                               prm.get("Poisson's ratio")));
+                               nu_text.str()));
         material.mu     = E / (2 * (1 + nu));
         material.lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
         if (dim == 2 && !plane_strain)
           material.lambda = 2 * material.lambda * material.mu /
                             (material.lambda + 2 * material.mu);
         material.body_force =
-          input::parse_expression<dim>(prm.get("Body force"),
+          input::parse_expression<dim>(entry.body_force,
                                        dim,
                                        "Materials/" + section + "/Body force",
                                        "",
                                        true);
         // Written as zeros ("0; 0", the 2D default): assembly skips it.
         material.body_force_is_zero = true;
-        for (const auto &part : input::split(prm.get("Body force"), ';'))
+        for (const auto &part : input::split(entry.body_force, ';'))
           material.body_force_is_zero &= input::number(part) == 0.;
-        prm.leave_subsection();
       }
-    prm.leave_subsection();
 
     // A contrast beyond 1e12 leaves fewer than 4 correct digits in the
     // soft body (round-off grows with the condition number).

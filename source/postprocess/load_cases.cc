@@ -16,31 +16,29 @@ namespace knee_contact
 
 
   void
-  LoadCases::declare_parameters(ParameterHandler &prm)
+  LoadCases::add_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Load cases");
-    prm.declare_entry(
+    prm.add_parameter(
       "Values of t",
-      "",
-      Patterns::Anything(),
+      entries,
       "The load parameter t of each load case, separated by ','; an entry "
       "'first:step:last' stands for first, first+step, ..., last. Traction, "
       "pressure and body force expressions (and exact solutions) may use t; "
-      "displacement conditions may not. Empty: one case at t = 0.");
+      "displacement conditions may not. Empty: one case at t = 0.",
+      Patterns::List(
+        Patterns::Anything(), 0, Patterns::List::max_int_value, ","));
     prm.leave_subsection();
   }
 
 
 
   void
-  LoadCases::parse_parameters(ParameterHandler &prm)
+  LoadCases::check_parameters()
   {
-    prm.enter_subsection("Load cases");
     const std::string parameter = "Load cases/Values of t";
-    const std::string text      = prm.get("Values of t");
-    prm.leave_subsection();
     t.clear();
-    for (const auto &entry : input::split(text, ','))
+    for (const auto &entry : entries)
       {
         const auto range = input::split(entry, ':');
         if (range.size() == 1)

@@ -79,47 +79,46 @@ namespace knee_contact
 
   template <int dim>
   void
-  OutputWriter<dim>::declare_parameters(ParameterHandler &prm)
+  OutputWriter<dim>::add_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Output");
-    prm.declare_entry("Folder",
-                      "",
-                      Patterns::Anything(),
+    prm.add_parameter("Folder",
+                      output_folder,
                       "Folder for the results, relative to the working "
-                      "directory; empty: output/<scene file's base name>.");
-    prm.declare_entry("Deformation magnification",
-                      "10",
-                      Patterns::Double(0),
+                      "directory; empty: output/<scene file's base name>.",
+                      Patterns::DirectoryName());
+    prm.add_parameter("Deformation magnification",
+                      magnification,
                       "Factor on the displacement in pictures of the "
-                      "deformed mesh (the seed's Fig. 2 uses 10).");
-    prm.declare_entry("Terminal",
-                      "normal",
-                      Patterns::Selection("normal|test"),
-                      "normal: progress, timings and a results table; test: "
-                      "only numbers that do not depend on the machine, for "
-                      "ctest.");
-    prm.declare_entry("Pictures",
-                      "true",
-                      Patterns::Bool(),
+                      "deformed mesh (the seed's Fig. 2 uses 10).",
+                      Patterns::Double(0));
+    input::add_selection(prm,
+                         "Terminal",
+                         terminal_test,
+                         {{"normal", false}, {"test", true}},
+                         "normal: progress, timings and a results table; "
+                         "test: only numbers that do not depend on the "
+                         "machine, for ctest.");
+    prm.add_parameter("Pictures",
+                      pictures,
                       "Draw deformation.png, stress_yy.png and "
                       "contact_pressure.png (3D: von_mises.png, the deformed "
                       "surface from two views) with matplotlib (needs Write "
                       "files).");
-    prm.declare_entry("Labels",
-                      "",
-                      Patterns::Anything(),
-                      "Points labelled in deformation.png: 'name: x, y; ...' "
-                      "[m], e.g. the seed's points 1-10 (3D: 'name: x, y, "
-                      "z').");
-    prm.declare_entry("Picture time limit",
-                      "600",
-                      Patterns::Double(1),
+    prm.add_parameter(
+      "Labels",
+      label_entries,
+      "Points labelled in deformation.png: 'name: x, y; ...' [m], e.g. the "
+      "seed's points 1-10 (3D: 'name: x, y, z').",
+      input::named_list_pattern(Patterns::List(Patterns::Double(), 2, 3)));
+    prm.add_parameter("Picture time limit",
+                      picture_time_limit,
                       "Seconds the picture script may take before it is "
                       "stopped (the result set is then kept without "
-                      "pictures, with a warning).");
-    prm.declare_entry("Write files",
-                      "true",
-                      Patterns::Bool(),
+                      "pictures, with a warning).",
+                      Patterns::Double(1));
+    prm.add_parameter("Write files",
+                      write_files,
                       "Write solution.vtu, contact CSVs and summary.json.");
     prm.leave_subsection();
   }
@@ -128,23 +127,23 @@ namespace knee_contact
 
   template <int dim>
   void
-  OutputWriter<dim>::parse_parameters(ParameterHandler  &prm,
-                                      const std::string &scene_file)
+  OutputWriter<dim>::check_parameters(const std::string &scene_file)
   {
-    prm.enter_subsection("Output");
-    output_folder = prm.get("Folder");
     if (output_folder.empty())
       output_folder =
         "output/" + std::filesystem::path(scene_file).stem().string();
-    magnification      = prm.get_double("Deformation magnification");
-    terminal_test      = prm.get("Terminal") == "test";
-    write_files        = prm.get_bool("Write files");
-    pictures           = prm.get_bool("Pictures");
-    picture_time_limit = prm.get_double("Picture time limit");
-    for (const auto &[name, point] :
-         input::split_named(prm.get("Labels"), "Output/Labels", "name: x, y"))
-      labels.emplace_back(name, input::to_point<dim>(point, "Output/Labels"));
-    prm.leave_subsection();
+    for (const auto &[name, point] : label_entries)
+      {
+        AssertThrow(!name.empty() && point.size() == dim,
+                    ExcMessage("Output/Labels: '" + name +
+                               "' needs a name and a point " +
+                               (dim == 2 ? "'x, y' (the mesh is 2D)"
+                                         : "'x, y, z' (the mesh is 3D)")));
+        Point<dim> p;
+        for (unsigned int d = 0; d < dim; ++d)
+          p[d] = point[d];
+        labels.emplace_back(name, p);
+      }
   }
 
 

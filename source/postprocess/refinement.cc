@@ -1,3 +1,4 @@
+#include <knee_contact/core/input.h>
 #include <knee_contact/physics/elements.h>
 #include <knee_contact/postprocess/refinement.h>
 
@@ -16,61 +17,55 @@
 namespace knee_contact
 {
   void
-  Refinement::declare_parameters(ParameterHandler &prm)
+  Refinement::add_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Refinement");
-    prm.declare_entry("Number of cycles",
-                      "1",
-                      Patterns::Integer(1, 20),
+    prm.add_parameter("Number of cycles",
+                      n_cycles,
                       "Solve on this many meshes, refining between them; "
-                      "errors and rates are tabulated.");
-    prm.declare_entry("Number of adaptive cycles",
-                      "0",
-                      Patterns::Integer(0, 30),
+                      "errors and rates are tabulated.",
+                      Patterns::Integer(1, 20));
+    prm.add_parameter("Number of adaptive cycles",
+                      n_adaptive_cycles,
                       "Cycles of the adaptive sequence, which grows more "
-                      "slowly than the uniform one; 0: Number of cycles.");
-    prm.declare_entry("Strategy",
-                      "global",
-                      Patterns::Selection("global|adaptive|compare"),
-                      "global: refine every cell; adaptive: refine the cells "
-                      "with the largest Kelly error estimate (energy "
-                      "weighted); compare: run both sequences and write "
-                      "study.csv, study_error_dofs.png and "
-                      "study_error_time.png (speed against error).");
-    prm.declare_entry("Refine fraction",
-                      "0.5",
-                      Patterns::Double(0, 1),
+                      "slowly than the uniform one; 0: Number of cycles.",
+                      Patterns::Integer(0, 30));
+    input::add_selection(
+      prm,
+      "Strategy",
+      strategy,
+      {{"global", Strategy::global},
+       {"adaptive", Strategy::adaptive},
+       {"compare", Strategy::compare}},
+      "global: refine every cell; adaptive: refine the cells with the "
+      "largest Kelly error estimate (energy weighted); compare: run both "
+      "sequences and write study.csv, study_error_dofs.png and "
+      "study_error_time.png (speed against error).");
+    prm.add_parameter("Refine fraction",
+                      refine_fraction,
                       "Adaptive: refine the cells that together carry this "
-                      "fraction of the estimated error (fixed fraction).");
-    prm.declare_entry("Indicator",
-                      "kelly+contact",
-                      Patterns::Selection("kelly|kelly+contact"),
-                      "Adaptive: kelly, or kelly+contact, which also refines "
-                      "every cell at the active contact zone (one slave "
-                      "vertex spacing around it), where the pressure is "
-                      "resolved. Both sides of an interface are refined "
-                      "together.");
+                      "fraction of the estimated error (fixed fraction).",
+                      Patterns::Double(0, 1));
+    input::add_selection(
+      prm,
+      "Indicator",
+      indicator,
+      {{"kelly", Indicator::kelly},
+       {"kelly+contact", Indicator::kelly_contact}},
+      "Adaptive: kelly, or kelly+contact, which also refines every cell at "
+      "the active contact zone (one slave vertex spacing around it), where "
+      "the pressure is resolved. Both sides of an interface are refined "
+      "together.");
     prm.leave_subsection();
   }
 
 
 
   void
-  Refinement::parse_parameters(ParameterHandler &prm)
+  Refinement::check_parameters()
   {
-    prm.enter_subsection("Refinement");
-    n_cycles          = prm.get_integer("Number of cycles");
-    n_adaptive_cycles = prm.get_integer("Number of adaptive cycles");
     if (n_adaptive_cycles == 0)
       n_adaptive_cycles = n_cycles;
-    const std::string s = prm.get("Strategy");
-    strategy            = s == "global"     ? Strategy::global
-                          : s == "adaptive" ? Strategy::adaptive
-                                            : Strategy::compare;
-    refine_fraction     = prm.get_double("Refine fraction");
-    indicator           = prm.get("Indicator") == "kelly" ? Indicator::kelly
-                                                          : Indicator::kelly_contact;
-    prm.leave_subsection();
   }
 
 

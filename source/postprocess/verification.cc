@@ -14,114 +14,113 @@ namespace knee_contact
 {
   template <int dim>
   void
-  Verification<dim>::declare_parameters(ParameterHandler &prm)
+  Verification<dim>::add_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Verification");
-    prm.declare_entry("Exact displacement",
-                      "",
-                      Patterns::Anything(),
+    prm.add_parameter("Exact displacement",
+                      entries.exact_displacement,
                       "Reference u = (u_x; u_y) [m] in x, y (3D: (u_x; u_y; "
                       "u_z) in x, y, z): L2, energy and nodal errors are "
-                      "reported. Empty: none.");
-    prm.declare_entry("Exact stress",
-                      "",
-                      Patterns::Anything(),
+                      "reported. Empty: none.",
+                      input::expression_pattern(3, true));
+    prm.add_parameter("Exact stress",
+                      entries.exact_stress,
                       "Reference (tau_xx; tau_yy; tau_xy) [Pa] (3D: (tau_xx; "
                       "tau_yy; tau_zz; tau_xy; tau_xz; tau_yz)): the maximum "
                       "error at the cells' Gauss points relative to the "
                       "largest reference stress is checked against "
-                      "Tolerance. Empty: none.");
-    prm.declare_entry("Exact contact pressure",
-                      "",
-                      Patterns::Anything(),
+                      "Tolerance. Empty: none.",
+                      input::expression_pattern(6, true));
+    prm.add_parameter("Exact contact pressure",
+                      entries.exact_pressure,
                       "Reference contact pressure [Pa] at the slave vertices: "
                       "the maximum error relative to its largest value is "
-                      "checked against Tolerance. Empty: none.");
-    prm.declare_entry("Tolerance",
-                      "1e-10",
-                      Patterns::Double(0),
+                      "checked against Tolerance. Empty: none.",
+                      input::expression_pattern(1, true));
+    prm.add_parameter("Tolerance",
+                      tolerance,
                       "Tolerance of the exact-field checks (relative); the "
                       "nodal displacement error is checked too when an "
-                      "exact displacement is given and Minimum L2 rate is 0.");
-    prm.declare_entry("Minimum L2 rate",
-                      "0",
-                      Patterns::Double(0),
+                      "exact displacement is given and Minimum L2 rate is 0.",
+                      Patterns::Double(0));
+    prm.add_parameter("Minimum L2 rate",
+                      min_l2_rate,
                       "With several refinement cycles: the smallest allowed "
                       "observed L2 rate after the first refinement (h ~ "
-                      "n_dofs^-1/2); 0: no check.");
-    prm.declare_entry("Minimum energy rate",
-                      "0",
-                      Patterns::Double(0),
-                      "The same for the energy norm error.");
-    prm.declare_entry("Maximum L2 error",
-                      "0",
-                      Patterns::Double(0),
+                      "n_dofs^-1/2); 0: no check.",
+                      Patterns::Double(0));
+    prm.add_parameter("Minimum energy rate",
+                      min_energy_rate,
+                      "The same for the energy norm error.",
+                      Patterns::Double(0));
+    prm.add_parameter("Maximum L2 error",
+                      max_l2_error,
                       "With an exact displacement: the largest allowed "
-                      "relative L2 error on the last mesh; 0: no check.");
-    prm.declare_entry("Minimum pressure rate",
-                      "0",
-                      Patterns::Double(0),
+                      "relative L2 error on the last mesh; 0: no check.",
+                      Patterns::Double(0));
+    prm.add_parameter("Minimum pressure rate",
+                      min_pressure_rate,
                       "The same for the L2 error of the contact pressure "
-                      "over the slave sides against Exact contact pressure.");
-    prm.declare_entry("Check KKT",
-                      "true",
-                      Patterns::Bool(),
+                      "over the slave sides against Exact contact pressure.",
+                      Patterns::Double(0));
+    prm.add_parameter("Check KKT",
+                      check_kkt,
                       "Check lambda >= 0, A x <= g (1e-10 of max |u|), "
                       "complementarity and equilibrium (1e-8) when the scene "
                       "has contact.");
-    prm.declare_entry("Reference peak pressure",
-                      "",
-                      Patterns::Anything(),
+    prm.add_parameter("Reference peak pressure",
+                      entries.peak_pressure,
                       "Constant expression for the expected largest contact "
-                      "pressure [Pa], e.g. a Hertz formula. Empty: none.");
-    prm.declare_entry("Peak pressure tolerance",
-                      "0.03",
-                      Patterns::Double(0),
-                      "Allowed relative error of the peak pressure.");
-    prm.declare_entry("Reference contact length",
-                      "",
-                      Patterns::Anything(),
+                      "pressure [Pa], e.g. a Hertz formula. Empty: none.",
+                      input::expression_pattern(1, true));
+    prm.add_parameter("Peak pressure tolerance",
+                      peak_tolerance,
+                      "Allowed relative error of the peak pressure.",
+                      Patterns::Double(0));
+    prm.add_parameter("Reference contact length",
+                      entries.contact_length,
                       "Constant expression for the expected length of slave "
                       "boundary in contact [m], summed over interfaces. "
-                      "Empty: none.");
-    prm.declare_entry("Contact length tolerance",
-                      "0",
-                      Patterns::Double(0),
-                      "Allowed absolute error of the contact length [m].");
-    prm.declare_entry("Reference energy",
-                      "",
-                      Patterns::Anything(),
+                      "Empty: none.",
+                      input::expression_pattern(1, true));
+    prm.add_parameter("Contact length tolerance",
+                      length_tolerance,
+                      "Allowed absolute error of the contact length [m].",
+                      Patterns::Double(0));
+    prm.add_parameter("Reference energy",
+                      entries.reference_energy,
                       "Constant expression for a(u,u) [J/m] of an overkill "
                       "solution: its relative error is checked against "
-                      "Energy tolerance. Empty: none.");
-    prm.declare_entry("Energy tolerance",
-                      "1e-3",
-                      Patterns::Double(0),
+                      "Energy tolerance. Empty: none.",
+                      input::expression_pattern(1, true));
+    prm.add_parameter("Energy tolerance",
+                      energy_tolerance,
                       "Allowed relative error of a(u,u) against Reference "
-                      "energy.");
-    prm.declare_entry("Reference extreme stress_yy",
-                      "",
-                      Patterns::Anything(),
-                      "'material name: value' [Pa]: the extreme (most "
-                      "negative if the value is negative, else largest) "
-                      "tau_yy in that material of an overkill solution; its "
-                      "relative error is checked against Extreme stress "
-                      "tolerance. Empty: none.");
-    prm.declare_entry("Extreme stress tolerance",
-                      "0.05",
-                      Patterns::Double(0),
-                      "Allowed relative error of that extreme tau_yy.");
-    prm.declare_entry("Reference contact forces",
-                      "",
-                      Patterns::Anything(),
-                      "Expected magnitude of the contact force on each "
-                      "interface's slave body [N/m]: 'interface name: "
-                      "constant expression; ...', e.g. the load a body held "
-                      "only by that interface carries.");
-    prm.declare_entry("Contact force tolerance",
-                      "1e-8",
-                      Patterns::Double(0),
-                      "Allowed relative error of those forces.");
+                      "energy.",
+                      Patterns::Double(0));
+    prm.add_parameter(
+      "Reference extreme stress_yy",
+      entries.extreme_stress,
+      "'material name: value' [Pa]: the extreme (most negative if the value "
+      "is negative, else largest) tau_yy in that material of an overkill "
+      "solution; its relative error is checked against Extreme stress "
+      "tolerance. Empty: none.",
+      input::named_list_pattern(Patterns::Anything()));
+    prm.add_parameter("Extreme stress tolerance",
+                      extreme_stress_tolerance,
+                      "Allowed relative error of that extreme tau_yy.",
+                      Patterns::Double(0));
+    prm.add_parameter(
+      "Reference contact forces",
+      entries.interface_forces,
+      "Expected magnitude of the contact force on each interface's slave "
+      "body [N/m]: 'interface name: constant expression; ...', e.g. the load "
+      "a body held only by that interface carries.",
+      input::named_list_pattern(Patterns::Anything()));
+    prm.add_parameter("Contact force tolerance",
+                      force_tolerance,
+                      "Allowed relative error of those forces.",
+                      Patterns::Double(0));
     prm.leave_subsection();
   }
 
@@ -129,65 +128,49 @@ namespace knee_contact
 
   template <int dim>
   void
-  Verification<dim>::parse_parameters(ParameterHandler &prm)
+  Verification<dim>::check_parameters()
   {
-    prm.enter_subsection("Verification");
-    const auto optional = [&prm](const std::string &name,
-                                 const unsigned int n_components) {
-      const std::string text = prm.get(name);
+    const auto optional = [](const std::string &text,
+                             const std::string &name,
+                             const unsigned int n_components) {
       return text.empty()
                ? nullptr
                : input::parse_expression<dim>(
                    text, n_components, "Verification/" + name, "", true);
     };
-    exact_displacement = optional("Exact displacement", dim);
-    exact_stress       = optional("Exact stress", dim == 2 ? 3 : 6);
-    exact_pressure     = optional("Exact contact pressure", 1);
-    tolerance          = prm.get_double("Tolerance");
-    min_l2_rate        = prm.get_double("Minimum L2 rate");
-    min_energy_rate    = prm.get_double("Minimum energy rate");
-    min_pressure_rate  = prm.get_double("Minimum pressure rate");
-    max_l2_error       = prm.get_double("Maximum L2 error");
-    check_kkt          = prm.get_bool("Check KKT");
-    if (!prm.get("Reference peak pressure").empty())
+    exact_displacement =
+      optional(entries.exact_displacement, "Exact displacement", dim);
+    exact_stress =
+      optional(entries.exact_stress, "Exact stress", dim == 2 ? 3 : 6);
+    exact_pressure =
+      optional(entries.exact_pressure, "Exact contact pressure", 1);
+    if (!entries.peak_pressure.empty())
       peak_pressure =
-        input::evaluate_constant(prm.get("Reference peak pressure"),
+        input::evaluate_constant(entries.peak_pressure,
                                  "Verification/Reference peak pressure");
-    peak_tolerance = prm.get_double("Peak pressure tolerance");
-    if (!prm.get("Reference contact length").empty())
+    if (!entries.contact_length.empty())
       contact_length =
-        input::evaluate_constant(prm.get("Reference contact length"),
+        input::evaluate_constant(entries.contact_length,
                                  "Verification/Reference contact length");
-    length_tolerance = prm.get_double("Contact length tolerance");
-    for (const auto &[name, value] :
-         input::split_named(prm.get("Reference contact forces"),
-                            "Verification/Reference contact forces",
-                            "name: value"))
+    if (!entries.reference_energy.empty())
+      reference_energy =
+        input::evaluate_constant(entries.reference_energy,
+                                 "Verification/Reference energy");
+    for (const auto &[name, value] : entries.interface_forces)
       interface_forces.emplace_back(
         name,
         input::evaluate_constant(value,
                                  "Verification/Reference contact forces"));
-    force_tolerance = prm.get_double("Contact force tolerance");
-    if (!prm.get("Reference energy").empty())
-      reference_energy =
-        input::evaluate_constant(prm.get("Reference energy"),
-                                 "Verification/Reference energy");
-    energy_tolerance         = prm.get_double("Energy tolerance");
-    extreme_stress_tolerance = prm.get_double("Extreme stress tolerance");
-    for (const auto &[name, value] :
-         input::split_named(prm.get("Reference extreme stress_yy"),
-                            "Verification/Reference extreme stress_yy",
-                            "material name: value"))
+    AssertThrow(entries.extreme_stress.size() <= 1,
+                ExcMessage("Verification/Reference extreme stress_yy: "
+                           "give one material, not several"));
+    for (const auto &[name, value] : entries.extreme_stress)
       {
-        AssertThrow(extreme_stress_material.empty(),
-                    ExcMessage("Verification/Reference extreme stress_yy: "
-                               "give one material, not several"));
         extreme_stress_material = name;
         extreme_stress =
           input::evaluate_constant(value,
                                    "Verification/Reference extreme stress_yy");
       }
-    prm.leave_subsection();
   }
 
 

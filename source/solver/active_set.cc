@@ -1,3 +1,4 @@
+#include <knee_contact/core/input.h>
 #include <knee_contact/solver/active_set.h>
 
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
@@ -19,52 +20,55 @@
 namespace knee_contact
 {
   void
-  ActiveSetSolver::declare_parameters(ParameterHandler &prm)
+  ActiveSetSolver::add_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Contact");
-    prm.declare_entry("Maximum active set iterations",
-                      "50",
-                      Patterns::Integer(1),
+    prm.add_parameter("Maximum active set iterations",
+                      max_iterations,
                       "Stop with converged = false after this many "
-                      "iterations.");
-    prm.declare_entry("Active set constant",
-                      "100",
-                      Patterns::Double(0),
-                      "c of the active-set test lambda_p + c ((A x)_p - "
-                      "g_p) > 0, in units of the largest Young's modulus "
-                      "(step-42 uses 100 E).");
-    prm.declare_entry("Tolerance",
-                      "1e-10",
-                      Patterns::Double(0),
+                      "iterations.",
+                      Patterns::Integer(1));
+    prm.add_parameter("Active set constant",
+                      c_relative,
+                      "c of the active-set test lambda_p + c ((A x)_p - g_p) "
+                      "> 0, in units of the largest Young's modulus (step-42 "
+                      "uses 100 E).",
+                      Patterns::Double(0));
+    prm.add_parameter("Tolerance",
+                      tolerance,
                       "Converged when the active set repeats and the "
                       "relative complementarity residual max_p |min(lambda_p "
                       "/ max lambda, (g_p - (A x)_p) / max |u|)| is below "
-                      "this (max |u| over the contact unknowns).");
-    prm.declare_entry("Cycle safeguard",
-                      "true",
-                      Patterns::Bool(),
+                      "this (max |u| over the contact unknowns).",
+                      Patterns::Double(0));
+    prm.add_parameter("Cycle safeguard",
+                      safeguard,
                       "When the active set returns to an earlier set, go on "
                       "releasing at most one pair per iteration (the most "
                       "negative lambda) while adding every penetrating pair; "
                       "false: stop with converged = false.");
-    prm.declare_entry("Solver",
-                      "automatic",
-                      Patterns::Selection("automatic|condensed|sparse|step-41"),
-                      "automatic: estimate the time and memory of the "
-                      "condensed and sparse paths before allocating and take "
-                      "the cheaper that fits (the log and summary.json say "
-                      "which and why); condensed: factorise once per mesh "
-                      "with the contact unknowns last and run the loop on "
-                      "their dense Schur complement (cheapest where the "
-                      "contact unknowns are few); sparse: one CHOLMOD "
-                      "analysis per mesh, one numeric factorisation per "
-                      "active set (memory of the sparse factor only); "
-                      "step-41: condense and factorise the whole system "
-                      "with UMFPACK in every iteration (the first "
-                      "version's path, kept for comparison).");
-    prm.declare_entry("Reference solve",
-                      "false",
-                      Patterns::Bool(),
+    std::vector<std::pair<std::string, LinearSolver>> paths;
+    for (const LinearSolver path : {LinearSolver::automatic,
+                                    LinearSolver::condensed,
+                                    LinearSolver::sparse,
+                                    LinearSolver::step41})
+      paths.emplace_back(solver_path_name(path), path);
+    input::add_selection(
+      prm,
+      "Solver",
+      solver,
+      paths,
+      "automatic: estimate the time and memory of the condensed and sparse "
+      "paths before allocating and take the cheaper that fits (the log and "
+      "summary.json say which and why); condensed: factorise once per mesh "
+      "with the contact unknowns last and run the loop on their dense Schur "
+      "complement (cheapest where the contact unknowns are few); sparse: one "
+      "CHOLMOD analysis per mesh, one numeric factorisation per active set "
+      "(memory of the sparse factor only); step-41: condense and factorise "
+      "the whole system with UMFPACK in every iteration (the first version's "
+      "path, kept for comparison).");
+    prm.add_parameter("Reference solve",
+                      reference_solve,
                       "After the contact solve, time one linear solve of the "
                       "same system with the final active set held fixed "
                       "(CHOLMOD, METIS ordering: the fastest linear solver "
@@ -76,22 +80,10 @@ namespace knee_contact
 
 
   void
-  ActiveSetSolver::parse_parameters(ParameterHandler &prm,
-                                    const double      max_youngs_modulus)
+  ActiveSetSolver::check_parameters(const double max_youngs_modulus)
   {
-    prm.enter_subsection("Contact");
-    max_iterations = prm.get_integer("Maximum active set iterations");
-    c              = prm.get_double("Active set constant") * max_youngs_modulus;
-    tolerance      = prm.get_double("Tolerance");
-    safeguard      = prm.get_bool("Cycle safeguard");
-    reference_solve        = prm.get_bool("Reference solve");
-    const std::string path = prm.get("Solver");
-    solver                 = path == "step-41"     ? LinearSolver::step41
-                             : path == "sparse"    ? LinearSolver::sparse
-                             : path == "condensed" ? LinearSolver::condensed
-                                                   : LinearSolver::automatic;
+    c = c_relative * max_youngs_modulus;
     AssertThrow(c > 0, ExcMessage("Contact/Active set constant must be > 0"));
-    prm.leave_subsection();
   }
 
 

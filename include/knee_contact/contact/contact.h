@@ -114,11 +114,24 @@ namespace knee_contact
   class ContactInterfaces
   {
   public:
-    static void
-    declare_parameters(ParameterHandler &prm, const unsigned int n_interfaces);
-
+    /**
+     * Declare the subsection "Contact" with the subsections 'Interface 0'
+     * ... 'Interface @p n_interfaces - 1', each entry bound to the member it
+     * sets.
+     */
     void
-    parse_parameters(ParameterHandler &prm, const unsigned int n_interfaces);
+    add_parameters(ParameterHandler &prm, const unsigned int n_interfaces);
+
+    /**
+     * After parsing: the checks the patterns cannot make (names valid and
+     * distinct as file names, two sides, no boundary id in two
+     * interfaces).
+     */
+    void
+    check_parameters() const;
+
+    /** 'Number of interfaces' as the scene gives it. */
+    unsigned int n_interfaces = 0;
 
     /**
      * Throw if a side's boundary id is missing, or both sides of an

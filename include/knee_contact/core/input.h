@@ -48,6 +48,59 @@ namespace knee_contact
                      const bool         load      = false);
 
     /**
+     * Declare the Selection entry @p entry and bind it to @p value through
+     * @p names (the word in the scene file, the value it stands for); the
+     * default is the name of @p value's value. This is add_parameter() for
+     * enums, which deal.II 9.4's Patterns::Tools::Convert does not convert
+     * (it does from 9.5 on): declare_entry() and add_action(), the two
+     * steps add_parameter() is made of.
+     */
+    template <typename Value>
+    void
+    add_selection(ParameterHandler                                 &prm,
+                  const std::string                                &entry,
+                  Value                                            &value,
+                  const std::vector<std::pair<std::string, Value>> &names,
+                  const std::string &documentation)
+    {
+      std::string selection, default_name;
+      for (const auto &[name, v] : names)
+        {
+          selection += (selection.empty() ? "" : "|") + name;
+          if (v == value && default_name.empty())
+            default_name = name;
+        }
+      prm.declare_entry(entry,
+                        default_name,
+                        Patterns::Selection(selection),
+                        documentation);
+      prm.add_action(entry, [&value, names](const std::string &text) {
+        for (const auto &[name, v] : names)
+          if (name == text)
+            value = v;
+      });
+    }
+
+    /**
+     * The pattern of a vector expression: 1 to @p max_components
+     * components separated by ';' (FunctionParser's own Convert uses this
+     * form); parse_expression() checks the exact count for the entry. An
+     * @p optional entry may be empty.
+     */
+    Patterns::List
+    expression_pattern(const unsigned int max_components,
+                       const bool         optional = false);
+
+    /**
+     * The pattern of "name: value; name: value; ..." with names that are
+     * any text without ':' or ';' and values of @p value_pattern; it
+     * converts to std::vector<std::pair<std::string, T>> (names may repeat:
+     * the caller says whether they may).
+     */
+    Patterns::List
+    named_list_pattern(const Patterns::PatternBase &value_pattern);
+
+    /**
      * Evaluate a constant expression such as "sqrt(0.01*0.5/pi)".
      */
     double
@@ -59,24 +112,6 @@ namespace knee_contact
      */
     std::vector<std::string>
     split(const std::string &text, const char separator);
-
-    /**
-     * Parse "name: value; name: value; ..." into (name, value) pairs; an
-     * entry without exactly one ':' is an error naming @p parameter and
-     * @p form, the expected shape of an entry.
-     */
-    std::vector<std::pair<std::string, std::string>>
-    split_named(const std::string &text,
-                const std::string &parameter,
-                const std::string &form);
-
-    /**
-     * A point from "x, y" (2D) or "x, y, z" (3D), or an error naming
-     * @p parameter.
-     */
-    template <int dim>
-    Point<dim>
-    to_point(const std::string &text, const std::string &parameter);
 
     /**
      * The finite number that is all of @p text, or nothing: the one number

@@ -86,8 +86,12 @@ namespace knee_contact
     static Counts
     read_counts(const std::string &scene_file);
 
+    /**
+     * Every parameter of a scene with its pattern, default and
+     * documentation (knee_contact --print-parameters).
+     */
     static void
-    declare_parameters(ParameterHandler &prm, const Counts &counts);
+    print_parameters(std::ostream &out);
 
     /**
      * Read the scene file; throws a one-line message on bad input.
@@ -155,6 +159,16 @@ namespace knee_contact
     }
 
   private:
+    /** The parts without a scene: for read_counts() and print_parameters(). */
+    ContactProblem() = default;
+
+    /**
+     * Declare every part's parameters, bound to the parts' members, with
+     * the numbered subsections of @p counts.
+     */
+    void
+    add_parameters(ParameterHandler &prm, const Counts &counts);
+
     /**
      * The mesh at refinement @p level: 0 on the first cycle; > 0 where the
      * mesh input remeshes instead of refining (MeshInput::remeshes()).

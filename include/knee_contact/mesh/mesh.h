@@ -11,6 +11,8 @@
 #include <array>
 #include <map>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 namespace knee_contact
@@ -23,8 +25,16 @@ namespace knee_contact
    * the mesh is kept for MeshInput to read), else 2. Errors of the mesh
    * file are thrown here, as MeshInput would.
    */
+  template <int dim>
+  class MeshInput;
+
+  /**
+   * @p mesh_input holds the Mesh subsection as the scene wrote it (bound by
+   * MeshInput::add_parameters() and parsed, nothing checked yet).
+   */
   unsigned int
-  scene_dimension(ParameterHandler &prm, const std::string &scene_file);
+  scene_dimension(const MeshInput<2> &mesh_input,
+                  const std::string  &scene_file);
 
 
 
@@ -41,11 +51,19 @@ namespace knee_contact
   class MeshInput
   {
   public:
-    static void
-    declare_parameters(ParameterHandler &prm);
-
+    /**
+     * Declare the Mesh subsection, each entry bound to the member it sets.
+     */
     void
-    parse_parameters(ParameterHandler &prm, const std::string &scene_file);
+    add_parameters(ParameterHandler &prm);
+
+    /**
+     * After parsing: resolve the file against @p scene_file and check what
+     * the patterns cannot (sets named twice, rectangles' corners, the
+     * centres' dimension, the file's existence).
+     */
+    void
+    check_parameters(const std::string &scene_file);
 
     /**
      * Build the coarse mesh, attach the circular manifolds and refine
@@ -115,6 +133,39 @@ namespace knee_contact
       rectangles,
       file
     };
+
+    /**
+     * The entries that become other members in check_parameters(), as the
+     * scene wrote them.
+     */
+    struct Entries
+    {
+      std::string                                       file;
+      std::string                                       gmsh_arguments;
+      std::vector<std::pair<std::string, unsigned int>> abaqus_element_sets;
+      std::vector<std::pair<std::string, unsigned int>> abaqus_boundary_sets;
+      // x0, y0, x1, y1, n_x, n_y, material id, group, left, right, bottom
+      // and top boundary ids.
+      std::vector<std::tuple<double,
+                             double,
+                             double,
+                             double,
+                             unsigned int,
+                             unsigned int,
+                             unsigned int,
+                             unsigned int,
+                             unsigned int,
+                             unsigned int,
+                             unsigned int,
+                             unsigned int>>
+        rectangles{{0, 0, 1, 1, 1, 1, 1, 0, 1, 2, 3, 4}};
+      std::vector<std::pair<unsigned int, std::vector<double>>>
+        circular_boundaries;
+    } entries;
+
+    friend unsigned int
+    scene_dimension(const MeshInput<2> &mesh_input,
+                    const std::string  &scene_file);
 
     Source                                   source = Source::rectangles;
     std::string                              file;

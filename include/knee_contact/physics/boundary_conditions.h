@@ -48,11 +48,24 @@ namespace knee_contact
   class BoundaryConditions
   {
   public:
-    static void
-    declare_parameters(ParameterHandler &prm, const unsigned int n_conditions);
-
+    /**
+     * Declare the subsection "Boundary conditions" with the subsections
+     * 'Condition 0' ... 'Condition @p n_conditions - 1', each entry bound to
+     * the member it sets.
+     */
     void
-    parse_parameters(ParameterHandler &prm, const unsigned int n_conditions);
+    add_parameters(ParameterHandler &prm, const unsigned int n_conditions);
+
+    /**
+     * After parsing: the conditions from the entries, with the checks the
+     * patterns cannot make (an id in one condition only, a component for a
+     * displacement, the expressions).
+     */
+    void
+    check_parameters();
+
+    /** 'Number of conditions' as the scene gives it. */
+    unsigned int n_conditions = 0;
 
     /**
      * Throw if a boundary id named in the scene is missing from the mesh.
@@ -86,6 +99,18 @@ namespace knee_contact
     }
 
   private:
+    /** One 'Condition k' subsection as the scene wrote it. */
+    struct Entry
+    {
+      std::vector<unsigned int> ids;
+      BoundaryType              type = BoundaryType::displacement;
+      std::vector<std::string>  components =
+        dim == 2 ? std::vector<std::string>{"x", "y"}
+                  : std::vector<std::string>{"x", "y", "z"};
+      std::string value = dim == 2 ? "0; 0" : "0; 0; 0";
+    };
+    std::vector<Entry> entries;
+
     std::vector<BoundaryCondition<dim>> list;
   };
 } // namespace knee_contact

@@ -69,11 +69,24 @@ namespace knee_contact
   class Materials
   {
   public:
-    static void
-    declare_parameters(ParameterHandler &prm, const unsigned int n_materials);
-
+    /**
+     * Declare the subsection "Materials" with the subsections 'Material 0'
+     * ... 'Material @p n_materials - 1', each entry bound to the member it
+     * sets.
+     */
     void
-    parse_parameters(ParameterHandler &prm, const unsigned int n_materials);
+    add_parameters(ParameterHandler &prm, const unsigned int n_materials);
+
+    /**
+     * After parsing: the table from the entries, with the checks the
+     * patterns cannot make (ids and names unique, E and nu in range, the
+     * contrast of the moduli, the body forces' expressions).
+     */
+    void
+    check_parameters();
+
+    /** 'Number of materials' as the scene gives it. */
+    unsigned int n_materials = 1;
 
     /**
      * Throw if a cell of @p triangulation has a material id without a
@@ -101,6 +114,19 @@ namespace knee_contact
     set_load_parameter(const double t);
 
   private:
+    /** One 'Material k' subsection as the scene wrote it. */
+    struct Entry
+    {
+      unsigned int material_id = 1;
+      std::string  name;
+      double       youngs_modulus     = 1e9;
+      double       poissons_ratio     = 0.3;
+      bool         reduced_volumetric = false;
+      std::string  body_force         = dim == 2 ? "0; 0" : "0; 0; 0";
+    };
+    std::vector<Entry> entries;
+    bool               plane_strain = true;
+
     std::map<types::material_id, Material<dim>> materials;
   };
 } // namespace knee_contact

@@ -25,11 +25,16 @@ namespace knee_contact
   class LoadCases
   {
   public:
-    static void
-    declare_parameters(ParameterHandler &prm);
-
+    /**
+     * Declare the subsection "Load cases", its entry bound to the member it
+     * sets.
+     */
     void
-    parse_parameters(ParameterHandler &prm);
+    add_parameters(ParameterHandler &prm);
+
+    /** After parsing: the values of t from the entries and ranges. */
+    void
+    check_parameters();
 
     /**
      * The values of t in the order given; {0} if the scene gives none.
@@ -80,7 +85,9 @@ namespace knee_contact
     folder(const unsigned int index);
 
   private:
-    std::vector<double> t = {0.};
+    /** 'Values of t' as the scene wrote it: numbers and ranges. */
+    std::vector<std::string> entries;
+    std::vector<double>      t = {0.};
   };
 } // namespace knee_contact
 

@@ -33,11 +33,19 @@ namespace knee_contact
   class OutputWriter
   {
   public:
-    static void
-    declare_parameters(ParameterHandler &prm);
-
+    /**
+     * Declare the subsection "Output", each entry bound to the member it
+     * sets.
+     */
     void
-    parse_parameters(ParameterHandler &prm, const std::string &scene_file);
+    add_parameters(ParameterHandler &prm);
+
+    /**
+     * After parsing: the default folder from @p scene_file's name, the
+     * labels' points.
+     */
+    void
+    check_parameters(const std::string &scene_file);
 
     /**
      * Lock the output folder and create the run's staging folder beside it
@@ -160,8 +168,10 @@ namespace knee_contact
     double                                          magnification = 10;
     bool                                            pictures      = true;
     std::vector<std::pair<std::string, Point<dim>>> labels;
-    bool                                            terminal_test = false;
-    bool                                            write_files   = true;
+    /** 'Labels' as the scene wrote them. */
+    std::vector<std::pair<std::string, std::vector<double>>> label_entries;
+    bool terminal_test = false;
+    bool write_files   = true;
   };
 } // namespace knee_contact
 

@@ -34,11 +34,16 @@ namespace knee_contact
       compare
     };
 
-    static void
-    declare_parameters(ParameterHandler &prm);
-
+    /**
+     * Declare the subsection "Refinement", each entry bound to the member it
+     * sets.
+     */
     void
-    parse_parameters(ParameterHandler &prm);
+    add_parameters(ParameterHandler &prm);
+
+    /** After parsing: Number of adaptive cycles 0 means Number of cycles. */
+    void
+    check_parameters();
 
     /**
      * Refine @p triangulation once with @p strategy (global or adaptive)
@@ -63,7 +68,7 @@ namespace knee_contact
 
     unsigned int n_cycles = 1;
     /** Cycles of the adaptive sequence (Strategy = adaptive or compare). */
-    unsigned int n_adaptive_cycles = 1;
+    unsigned int n_adaptive_cycles = 0;
     Strategy     strategy          = Strategy::global;
 
   private:

@@ -53,11 +53,19 @@ namespace knee_contact
   class ActiveSetSolver
   {
   public:
-    static void
-    declare_parameters(ParameterHandler &prm);
-
+    /**
+     * Declare the solver's entries of the subsection "Contact", each bound
+     * to the member it sets.
+     */
     void
-    parse_parameters(ParameterHandler &prm, const double max_youngs_modulus);
+    add_parameters(ParameterHandler &prm);
+
+    /**
+     * After parsing: the active-set constant in units of
+     * @p max_youngs_modulus, the stiffness scale of the scene.
+     */
+    void
+    check_parameters(const double max_youngs_modulus);
 
     /**
      * How the linear systems of the loop are solved (see ContactSystem).
@@ -158,7 +166,9 @@ namespace knee_contact
                        const Vector<double>          &x);
 
   private:
-    unsigned int max_iterations  = 50;
+    unsigned int max_iterations = 50;
+    /** Active set constant as the scene gives it, in units of E_max. */
+    double       c_relative      = 100;
     double       c               = 0;
     double       tolerance       = 1e-10;
     bool         safeguard       = true;
