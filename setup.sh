@@ -10,10 +10,12 @@ cd "$(dirname "$0")"
 # machinery; gmsh meshes .geo scenes; OpenBLAS makes UMFPACK 5-6x faster than
 # the reference BLAS; nlohmann-json writes summary.json with real numbers;
 # the condensed contact solver calls CHOLMOD (libsuitesparse-dev) and METIS;
-# zlib inflates compressed VTU meshes.
+# zlib inflates compressed VTU meshes; meshio and VTK 9 (Python) write the
+# mesh files of other programs that the format tests read.
 packages="cmake make g++ libdeal.ii-dev numdiff perl openmpi-bin gmsh
           libopenblas0-pthread nlohmann-json3-dev python3-matplotlib
-          libsuitesparse-dev libmetis-dev zlib1g-dev"
+          libsuitesparse-dev libmetis-dev zlib1g-dev python3-meshio
+          python3-vtk9"
 missing=""
 for package in $packages; do
   dpkg-query -W -f='${Status}' "$package" 2>/dev/null |

@@ -232,6 +232,12 @@ namespace knee_contact
     verification.check_parameters();
     refinement.check_parameters();
     mesh_input.adaptive = refinement.strategy != Refinement::Strategy::global;
+    std::set<types::boundary_id> boundary_ids;
+    for (const auto &condition : boundary_conditions.conditions())
+      boundary_ids.insert(condition.ids.begin(), condition.ids.end());
+    for (const auto &interface : contact_interfaces.interfaces())
+      boundary_ids.insert({interface.slave_id, interface.master_id});
+    mesh_input.set_scene_ids(materials.ids(), boundary_ids);
     scene_checks::check_roles(boundary_conditions, contact_interfaces);
     AssertThrow(dim == 2 || contact_interfaces.interfaces().empty(),
                 ExcMessage("Contact/Number of interfaces: the mesh is 3D and "

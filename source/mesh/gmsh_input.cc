@@ -194,5 +194,50 @@ namespace knee_contact
           describe_failure(
             result, "gmsh", geo, "Mesh/Gmsh time limit", time_limit));
     }
+
+
+
+    bool
+    is_binary_msh(const std::string &file)
+    {
+      std::ifstream in(file, std::ios::binary);
+      std::string   header, format;
+      std::getline(in, header);
+      std::getline(in, format);
+      std::istringstream words(format);
+      std::string        version, file_type;
+      words >> version >> file_type;
+      return (header == "$MeshFormat" || header == "$MeshFormat\r") &&
+             file_type == "1";
+    }
+
+
+
+    void
+    convert(const std::string &binary_msh,
+            const std::string &msh,
+            const double       time_limit)
+    {
+      // -0: read the file and write it out again, no meshing.
+      const std::vector<std::string> command = {"gmsh",
+                                                "-0",
+                                                "-format",
+                                                "msh41",
+                                                "-v",
+                                                "2",
+                                                "-nopopup",
+                                                "-o",
+                                                msh,
+                                                binary_msh};
+      const std::string              log =
+        std::filesystem::path(msh).replace_extension(".log").string();
+      const ProgramResult result = run_program(command, log, time_limit);
+      if (result.exit_code != 0 || !std::ifstream(msh).good() ||
+          result.message.find("rror") != std::string::npos)
+        throw std::runtime_error(
+          "Mesh/File: " +
+          describe_failure(
+            result, "gmsh", binary_msh, "Mesh/Gmsh time limit", time_limit));
+    }
   } // namespace gmsh_input
 } // namespace knee_contact

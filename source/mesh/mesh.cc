@@ -39,14 +39,17 @@ namespace knee_contact
       "File",
       entries.file,
       "Mesh file, relative to the scene file, read by its extension: .msh "
-      "(Gmsh 2.2 or 4.1 ASCII) or .geo (meshed by the gmsh program): in 2D "
+      "(Gmsh 2.2 or 4.1, ASCII or binary) or .geo (meshed by the gmsh "
+      "program): in 2D "
       "physical surfaces become material ids, physical curves boundary ids; "
       "a mesh with tetrahedra or hexahedra is solved in 3D, with physical "
       "volumes as material ids and physical surfaces as boundary ids. 2D "
       "only: .inp (Abaqus input deck): see Abaqus element sets and Abaqus "
-      "boundary sets; .vtk (legacy ASCII VTK) and .vtu (VTK XML), "
-      "unstructured grids: the cell field MaterialID gives material ids, and "
-      "of line cells boundary ids; .ucd (AVS UCD). 2D cells are triangles, "
+      "boundary sets; .vtk (legacy VTK, layouts 4.2 and 5.1, ASCII or "
+      "binary) and .vtu (VTK XML), unstructured grids: the cell field "
+      "MaterialID (or gmsh:physical, CellEntityIds, medit:ref) gives "
+      "material ids, and of line cells boundary ids; .ucd (AVS UCD). 2D cells "
+      "are triangles, "
       "quadrilaterals or both.",
       Patterns::FileName());
     input::add_selection(

@@ -30,7 +30,8 @@ namespace knee_contact
   {
     /**
      * A .msh ready to read: the user's file, or the mesh gmsh made of a .geo
-     * in a private temporary folder (removed on Ctrl-C too, and when this
+     * (or the ASCII copy gmsh wrote of a binary .msh) in a private temporary
+     * folder (removed on Ctrl-C too, and when this
      * goes), checked by check_msh, with the dimension of its cells.
      */
     struct CheckedMsh
@@ -70,7 +71,8 @@ namespace knee_contact
       result->file      = file;
       result->arguments = arguments;
       result->msh       = file;
-      if (std::filesystem::path(file).extension() == ".geo")
+      const bool geo    = std::filesystem::path(file).extension() == ".geo";
+      if (geo || gmsh_input::is_binary_msh(file))
         {
           std::string folder =
             (std::filesystem::temp_directory_path() / "knee_contact_XXXXXX")
@@ -80,7 +82,10 @@ namespace knee_contact
           interruption::register_folder(folder);
           result->folder = folder;
           result->msh    = folder + "/mesh.msh";
-          gmsh_input::mesh(file, result->msh, arguments, time_limit);
+          if (geo)
+            gmsh_input::mesh(file, result->msh, arguments, time_limit);
+          else
+            gmsh_input::convert(file, result->msh, time_limit);
         }
       // deal.II's reader trusts its input; check the file first.
       try
@@ -148,10 +153,16 @@ namespace knee_contact
       }
     auto msh = checked_msh(file, arguments, gmsh_time_limit);
     AssertThrow(msh->dim == dim, ExcInternalError());
+    // An entity in several physical groups: the one the scene names.
+    std::istringstream one_group(gmsh_input::one_group_per_entity(
+      msh->msh, file, dim, scene_material_ids, scene_boundary_ids));
+    std::ifstream      in_file(msh->msh);
+    std::istream      &in = one_group.str().empty()
+                              ? static_cast<std::istream &>(in_file)
+                              : static_cast<std::istream &>(one_group);
     Triangulation<dim> read;
     GridIn<dim>        grid_in;
     grid_in.attach_triangulation(read);
-    std::ifstream in(msh->msh);
     try
       {
         grid_in.read_msh(in);
@@ -165,34 +176,6 @@ namespace knee_contact
       }
     msh.reset();
     mesh_readers::Description<dim> mesh;
-    std::tie(mesh.vertices, mesh.cells, mesh.subcells) =
-      GridTools::get_coarse_mesh_description(read);
-    return mesh;
-  }
-
-
-
-  template <int dim>
-  mesh_readers::Description<2>
-  MeshInput<dim>::read_vtk() const
-  {
-    mesh_readers::check_vtk(file);
-    Triangulation<2> read;
-    GridIn<2>        grid_in;
-    grid_in.attach_triangulation(read);
-    std::ifstream in(file);
-    try
-      {
-        grid_in.read_vtk(in);
-      }
-    catch (const std::exception &exc)
-      {
-        AssertThrow(false,
-                    ExcMessage("Mesh/File: cannot read '" + file +
-                               "' as a VTK mesh (" +
-                               input::one_line(exc.what()) + ")"));
-      }
-    mesh_readers::Description<2> mesh;
     std::tie(mesh.vertices, mesh.cells, mesh.subcells) =
       GridTools::get_coarse_mesh_description(read);
     return mesh;
@@ -226,7 +209,7 @@ namespace knee_contact
                                            abaqus_element_sets,
                                            abaqus_boundary_sets);
         else if (extension == ".vtk")
-          mesh = read_vtk();
+          mesh = mesh_readers::read_vtk(file);
         else if (extension == ".vtu")
           mesh = mesh_readers::read_vtu(file);
         else if (extension == ".ucd")
@@ -417,7 +400,6 @@ namespace knee_contact
 #define KNEE_CONTACT_INSTANTIATE(dim)                                        \
   template mesh_readers::Description<dim> MeshInput<dim>::read_gmsh(         \
     const unsigned int) const;                                               \
-  template mesh_readers::Description<2> MeshInput<dim>::read_vtk() const;    \
   template void MeshInput<dim>::read_file(Triangulation<dim> &,              \
                                           const unsigned int) const;         \
   template void MeshInput<dim>::finish(mesh_readers::Description<dim> &,     \

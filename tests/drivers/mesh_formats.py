@@ -9,7 +9,15 @@ for the contact sides, named in the scene; and gmsh writes its own .inp
 with line elements for the sides), as a legacy VTK file and as
 VTK XML .vtu files in the four encodings VTK and ParaView write (ascii,
 base64, base64 of zlib blocks, raw appended; MaterialID of cells and of
-boundary lines), and as an AVS UCD file. The scene is the contact patch
+boundary lines), and as an AVS UCD file; and as other programs write it:
+meshio 5 (legacy VTK 5.1 ASCII and binary, .vtu with zlib; ids in
+gmsh:physical), VTK 9 (5.1 ASCII with METADATA blocks, 5.1 and 4.2 binary)
+and gmsh's VTK export (ASCII and binary, CellEntityIds), plus a 4.2 binary
+file written here from the format's description (double and float points,
+a POINT_DATA vector to skip); gmsh's binary .msh 4.1; and the .msh (2.2
+and 4.1) of the same
+mesh with its contact sides and both blocks also in a physical group the
+scene does not name. The scene is the contact patch
 test of tests/scenes/contact_patch_matching.prm (stiff block pressed on a soft one,
 sides sliding, node pairs on the matching interface).
 
@@ -62,15 +70,15 @@ end
 subsection Boundary conditions
   set Number of conditions = 3
   subsection Condition 0
-    set Boundary ids = 3
+    set Boundary ids = {bottom}
     set Type         = displacement
   end
   subsection Condition 1
-    set Boundary ids = 1, 2
+    set Boundary ids = {sides}
     set Type         = sliding
   end
   subsection Condition 2
-    set Boundary ids = 4
+    set Boundary ids = {top}
     set Type         = pressure
     set Value        = 1e6
   end
@@ -79,8 +87,8 @@ subsection Contact
   set Number of interfaces = 1
   subsection Interface 0
     set Name               = blocks
-    set Slave boundary id  = 6
-    set Master boundary id = 5
+    set Slave boundary id  = {slave}
+    set Master boundary id = {master}
     set Pairing            = node-to-node
   end
 end
@@ -154,6 +162,104 @@ def write_inp(path, nodes, cells, lines):
         f.write("\n".join(out) + "\n")
 
 
+def write_inp_parts(path, nodes, cells, lines, include=True):
+    """Abaqus deck as Abaqus/CAE writes a contact model, by hand from the
+    keywords' documented layout: one *Part per body with its own node and
+    element numbers from 1 and its own coordinates, an *Assembly with one
+    *Instance per part (the lower block translated, the upper block rotated
+    by 90 degrees about the z axis through (0.5, 1.5) and translated by
+    zero), part sets (BOTTOM of the lower part, found through its only
+    instance; TOP of the upper, named Upper-1.TOP in the scene), surfaces of
+    the assembly from internal element sets with instance= (the contact
+    sides, and LEFT and RIGHT over both instances), *Solid Section per part
+    (material ids 1 and 2 in file order), *Material with *Elastic, a *Step,
+    a keyword line continued after a comma, and the assembly in a second
+    file read through *Include (or in the deck if not include)."""
+    parts = {1: "Lower", 2: "Upper"}
+    side_names = {1: "LEFT", 2: "RIGHT", 3: "BOTTOM", 4: "TOP",
+                  5: "CONTACT_LOWER", 6: "CONTACT_UPPER"}
+    out = ["*Heading", "** written by tests/drivers/mesh_formats.py",
+           "*Preprint, echo=NO, model=NO,", " history=NO, contact=NO"]
+    local = {}  # body -> ({global node: local node}, {cell index: local})
+    faces = {}  # side -> [(body, local element, face number)]
+    for body, name in parts.items():
+        body_cells = [(e, c) for e, c in enumerate(cells) if c[0] == body]
+        body_nodes = sorted({t for _, c in body_cells for t in c[1]})
+        node_of = {t: i + 1 for i, t in enumerate(body_nodes)}
+        element_of = {e: i + 1 for i, (e, _) in enumerate(body_cells)}
+        local[body] = (node_of, element_of)
+        out += ["*Part, name=%s" % name, "*Node"]
+        for t in body_nodes:
+            x, y = nodes[t]
+            if body == 1:
+                # Instance Lower-1 is translated by (0, -5, 0).
+                x, y = x, y + 5.0
+            else:
+                # Instance Upper-1 is rotated by +90 degrees about
+                # (0.5, 1.5): the part holds the body turned by -90.
+                x, y = 0.5 + (y - 1.5), 1.5 - (x - 0.5)
+            out.append("%d, %.17g, %.17g" % (node_of[t], x, y))
+        for n, kind in ((3, "CPE3"), (4, "CPE4R")):
+            members = [(element_of[e], c) for e, c in body_cells
+                       if len(c[1]) == n]
+            if members:
+                out.append("*Element, type=%s" % kind)
+                out += ["%d, %s" % (i, ", ".join(str(node_of[t])
+                                                 for t in c[1]))
+                        for i, c in members]
+        out += ["*Elset, elset=%s_BODY, generate" % name.upper(),
+                "1, %d, 1" % len(body_cells)]
+        for side, tag in ((3, "BOTTOM"), (4, "TOP")):
+            side_nodes = sorted({node_of[t] for l in lines if l[0] == side
+                                 for t in l[1] if t in node_of})
+            if side_nodes:
+                out.append("*Nset, nset=%s" % tag)
+                out += ["%d," % t for t in side_nodes]
+        out += ["** Section: %s" % name,
+                "*Solid Section, elset=%s_BODY, material=M%d" % (
+                    name.upper(), body), ",", "*End Part"]
+        for side in (1, 2, 5, 6):
+            for a, b in [l[1] for l in lines if l[0] == side]:
+                for e, (_, c) in body_cells:
+                    for k in range(len(c)):
+                        if {c[k], c[(k + 1) % len(c)]} == {a, b}:
+                            faces.setdefault(side, []).append(
+                                (body, element_of[e], k + 1))
+    assembly = ["*Assembly, name=Assembly", "*Instance, name=Lower-1, "
+                "part=Lower", "0., -5., 0.", "*End Instance",
+                "*Instance, name=Upper-1, part=Upper", "0., 0., 0.",
+                "0.5, 1.5, 0., 0.5, 1.5, 1., 90.", "*End Instance"]
+    for side in (1, 2, 5, 6):
+        name = side_names[side]
+        lines_of_surface = []
+        for body in (1, 2):
+            for k in range(1, 5):
+                members = [e for b, e, f in faces[side] if b == body and
+                           f == k]
+                if members:
+                    elset = "_%s_S%d_%s" % (name, k, parts[body])
+                    assembly += ["*Elset, elset=%s, internal, instance=%s-1"
+                                 % (elset, parts[body])]
+                    assembly += ["%d," % e for e in members]
+                    lines_of_surface.append("%s, S%d" % (elset, k))
+        assembly += ["*Surface, type=ELEMENT, name=%s" % name]
+        assembly += lines_of_surface
+    assembly.append("*End Assembly")
+    if include:
+        name = os.path.splitext(path)[0] + "_assembly.inp"
+        with open(name, "w") as f:
+            f.write("\n".join(assembly) + "\n")
+        out.append("*Include, input=%s" % os.path.basename(name))
+    else:
+        out += assembly
+    out += ["*Material, name=M1", "*Elastic", "1e9, 0.3",
+            "*Material, name=M2", "*Elastic", "3e9, 0.2",
+            "*Step, name=Load, nlgeom=NO", "*Static", "1., 1., 1e-05, 1.",
+            "*End Step"]
+    with open(path, "w") as f:
+        f.write("\n".join(out) + "\n")
+
+
 def write_vtk(path, nodes, cells, lines):
     index = {t: i for i, t in enumerate(nodes)}
     all_cells = cells + lines
@@ -172,6 +278,40 @@ def write_vtk(path, nodes, cells, lines):
     out += [str(c[0]) for c in all_cells]
     with open(path, "w") as f:
         f.write("\n".join(out) + "\n")
+
+
+def write_vtk42_binary(path, nodes, cells, lines, point_type):
+    """Legacy VTK 4.2, BINARY, written from the format's documented layout:
+    big-endian values right after each keyword line, CELLS as counts and
+    vertices (int), points as float or double, MaterialID as SCALARS int
+    with a lookup table, and a POINT_DATA vector field that the reader must
+    skip."""
+    index = {t: i for i, t in enumerate(nodes)}
+    all_cells = cells + lines
+    code = {"float": "f", "double": "d"}[point_type]
+    out = [b"# vtk DataFile Version 4.2\nmesh_formats.py\nBINARY\n"
+           b"DATASET UNSTRUCTURED_GRID\n",
+           b"POINTS %d %s\n" % (len(nodes), point_type.encode()),
+           struct.pack(">%d%s" % (3 * len(nodes), code),
+                       *[v for p in nodes.values() for v in (p[0], p[1], 0)]),
+           b"\n"]
+    ints = []
+    for _, tags in all_cells:
+        ints += [len(tags)] + [index[t] for t in tags]
+    out += [b"CELLS %d %d\n" % (len(all_cells), len(ints)),
+            struct.pack(">%di" % len(ints), *ints), b"\n",
+            b"CELL_TYPES %d\n" % len(all_cells),
+            struct.pack(">%di" % len(all_cells),
+                        *[{2: 3, 3: 5, 4: 9}[len(c[1])] for c in all_cells]),
+            b"\n", b"CELL_DATA %d\n" % len(all_cells),
+            b"SCALARS MaterialID int 1\nLOOKUP_TABLE default\n",
+            struct.pack(">%di" % len(all_cells), *[c[0] for c in all_cells]),
+            b"\n", b"POINT_DATA %d\n" % len(nodes),
+            b"VECTORS displacement double\n",
+            struct.pack(">%dd" % (3 * len(nodes)), *([0.5] * 3 * len(nodes))),
+            b"\n"]
+    with open(path, "wb") as f:
+        f.write(b"".join(out))
 
 
 def write_ucd(path, nodes, cells, lines):
@@ -263,13 +403,18 @@ def write_vtu(path, nodes, cells, lines, encoding):
         f.write(b"</VTKFile>\n")
 
 
+# The boundary ids of the scene: patch_stack.geo's physical curves.
+PHYSICAL_IDS = dict(bottom="3", sides="1, 2", top="4", slave="6", master="5")
+
+
 def run(binary, folder, name, mesh, sets, pictures=False):
     out = os.path.join(folder, name)
     scene = os.path.join(folder, name + ".prm")
     with open(scene, "w") as f:
         f.write(SCENE.format(file=mesh, folder=out,
                              pictures="true" if pictures else "false",
-                             element_sets=sets[0], boundary_sets=sets[1]))
+                             element_sets=sets[0], boundary_sets=sets[1],
+                             **PHYSICAL_IDS))
     result = subprocess.run([binary, scene], stdout=subprocess.PIPE,
                             stderr=subprocess.STDOUT, text=True)
     if result.returncode != 0:
@@ -379,6 +524,16 @@ def main():
             failures += compare(kind + ".vtk", reference,
                                 run(binary, folder, kind + "_vtk", vtk,
                                     no_sets))
+            # The model as Abaqus/CAE writes it: parts, instances moved,
+            # surfaces of the assembly over two instances.
+            parts_inp = os.path.join(folder, kind + "_parts.inp")
+            write_inp_parts(parts_inp, nodes, cells, lines)
+            parts_sets = ("", "LEFT: 1; RIGHT: 2; BOTTOM: 3; Upper-1.TOP: 4; "
+                              "CONTACT_LOWER: 5; CONTACT_UPPER: 6")
+            failures += compare(kind + ".inp of parts and instances",
+                                reference,
+                                run(binary, folder, kind + "_parts_inp",
+                                    parts_inp, parts_sets))
             # Gmsh's own Abaqus export (an independent writer: physical
             # curves as T3D2 line elements, sets named Physical...).
             gmsh_inp = os.path.join(folder, kind + "_gmsh.inp")
@@ -405,6 +560,110 @@ def main():
                     "%s.vtu (%s)" % (kind, encoding), reference,
                     run(binary, folder, kind + "_vtu_" + encoding, vtu,
                         no_sets))
+            # Entities in two physical groups (Gmsh allows it; deal.II 9.4
+            # refuses more than one tag): the contact sides and the top
+            # also in curve group 7 and both blocks in surface group 3,
+            # which the scene does not name, in both .msh versions.
+            for version in ("msh22", "msh41"):
+                path = os.path.join(folder, "%s_groups_%s.msh" % (kind,
+                                                                  version))
+                subprocess.run(["gmsh", "-2", "-format", version, GEO, "-o",
+                                path, "-setnumber", "groups", "1"] + arguments,
+                               check=True, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)
+                failures += compare(
+                    "%s .%s with entities in two physical groups"
+                    % (kind, version), reference,
+                    run(binary, folder, "%s_groups_%s" % (kind, version),
+                        path, no_sets))
+            # Binary .msh 4.1 (gmsh -bin), which deal.II 9.4 reads only
+            # through the Gmsh API: converted by the gmsh program.
+            path = os.path.join(folder, kind + "_binary.msh")
+            subprocess.run(["gmsh", "-2", "-format", "msh41", "-bin", GEO,
+                            "-o", path] + arguments, check=True,
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            with open(path, "rb") as f:
+                assert f.read().split(b"\n")[1].split()[1] == b"1", path
+            failures += compare("%s .msh 4.1 binary" % kind, reference,
+                                run(binary, folder, kind + "_binary_msh",
+                                    path, no_sets))
+            # Legacy VTK as other programs write it: meshio (the 5.1 layout,
+            # ASCII and binary, ids in a FIELD array gmsh:physical; and its
+            # zlib .vtu), gmsh's own export (2.0 layout, ASCII and binary,
+            # physical groups as CellEntityIds), and the 4.2 binary
+            # layout written here from the format's description.
+            import meshio
+            mesh = meshio.read(msh)
+            for name, options in (("meshio_ascii.vtk", dict(binary=False)),
+                                  ("meshio_binary.vtk", dict(binary=True)),
+                                  ("meshio.vtu", {})):
+                path = os.path.join(folder, kind + "_" + name)
+                meshio.write(path, mesh, **options)
+                failures += compare(
+                    "%s %s (written by meshio %s)" % (kind, name,
+                                                     meshio.__version__),
+                    reference,
+                    run(binary, folder, kind + "_" + name.replace(".", "_"),
+                        path, no_sets))
+            for name, options in (("gmsh_ascii.vtk", []),
+                                  ("gmsh_binary.vtk", ["-bin"])):
+                path = os.path.join(folder, kind + "_" + name)
+                subprocess.run(["gmsh", "-2", "-format", "vtk", GEO, "-o",
+                                path] + options + arguments, check=True,
+                               stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)
+                failures += compare(
+                    "%s %s (written by gmsh)" % (kind, name), reference,
+                    run(binary, folder, kind + "_" + name.replace(".", "_"),
+                        path, no_sets))
+            # VTK 9 itself (python3-vtk9): the legacy writer of the format's
+            # owner, 5.1 ASCII with METADATA blocks (a component name, the
+            # points' norm range) that the reader must skip, 5.1 binary and
+            # 4.2 binary, from meshio's .vtu read by VTK's XML reader.
+            import vtk
+            reader = vtk.vtkXMLUnstructuredGridReader()
+            reader.SetFileName(os.path.join(folder, kind + "_meshio.vtu"))
+            reader.Update()
+            grid = reader.GetOutput()
+            grid.GetCellData().GetArray("gmsh:physical").SetComponentName(
+                0, "physical group")
+            grid.GetPoints().GetData().GetRange(-1)
+            for name, version, binary_file in (("51_ascii", 51, False),
+                                               ("51_binary", 51, True),
+                                               ("42_binary", 42, True)):
+                path = os.path.join(folder, "%s_vtk9_%s.vtk" % (kind, name))
+                writer = vtk.vtkUnstructuredGridWriter()
+                writer.SetFileName(path)
+                writer.SetInputData(grid)
+                writer.SetFileVersion(version)
+                if binary_file:
+                    writer.SetFileTypeToBinary()
+                writer.Write()
+                with open(path, "rb") as f:
+                    assert version == 42 or b"METADATA" in f.read(), path
+                written = "%s .vtk %s (written by VTK %s)" % (
+                    kind, name, vtk.vtkVersion.GetVTKVersion())
+                result = run(binary, folder, "%s_vtk9_%s" % (kind, name),
+                             path, no_sets)
+                if binary_file:
+                    failures += compare(written, reference, result)
+                else:
+                    # VTK writes ASCII coordinates to 6 digits: the mesh
+                    # moves, so only the analytic checks (exit code 0 in
+                    # run()) apply.
+                    print("%s: analytic checks pass" % written)
+            path = os.path.join(folder, kind + "_42_double.vtk")
+            write_vtk42_binary(path, nodes, cells, lines, "double")
+            failures += compare("%s .vtk 4.2 binary" % kind, reference,
+                                run(binary, folder, kind + "_42_double",
+                                    path, no_sets))
+            # Float points: the mesh moves by round-off, so only the
+            # analytic checks (run() requires exit code 0) apply.
+            path = os.path.join(folder, kind + "_42_float.vtk")
+            write_vtk42_binary(path, nodes, cells, lines, "float")
+            run(binary, folder, kind + "_42_float", path, no_sets)
+            print("%s .vtk 4.2 binary, float points: analytic checks pass"
+                  % kind)
     if failures:
         raise SystemExit("%d differences" % failures)
 

@@ -2,8 +2,10 @@
 """Hostile mesh files for every reader knee_contact has written by hand.
 
 The contact patch mesh of tests/meshes/patch_stack.geo (a mixed mesh) is
-written in every format mesh_formats.py writes (.msh, our and Gmsh's .inp,
-.vtk, .ucd, .vtu in five encodings); each file is then damaged with a fixed
+written in every format mesh_formats.py writes (.msh ASCII and binary, our
+flat and multi-part and Gmsh's .inp,
+.vtk in the ASCII and binary 4.2 layout and meshio's ASCII and binary 5.1
+layout, .ucd, .vtu in five encodings); each file is then damaged with a fixed
 seed: cut at several offsets, bytes overwritten by random bytes, a digit
 changed into a large or negative number, lines dropped or repeated. Every
 damaged file is run through the scene; as in fuzz.py, each run must end
@@ -33,7 +35,9 @@ SETS = {".inp": ("BODY_1: 1; BODY_2: 2",
                  "; ".join("SIDE_%d: %d" % (i, i) for i in range(1, 7))),
         "_gmsh.inp": ("PhysicalSurface1: 1; PhysicalSurface2: 2",
                       "; ".join("PhysicalLine%d: %d" % (i, i)
-                                for i in range(1, 7)))}
+                                for i in range(1, 7))),
+        "_parts.inp": ("", "LEFT: 1; RIGHT: 2; BOTTOM: 3; Upper-1.TOP: 4; "
+                           "CONTACT_LOWER: 5; CONTACT_UPPER: 6")}
 
 
 def damage(data, rng):
@@ -78,12 +82,31 @@ def main():
                        check=True, stdout=subprocess.DEVNULL,
                        stderr=subprocess.DEVNULL)
         nodes, cells, lines = mesh_formats.read_msh22(msh)
-        files = {".msh": msh, "_gmsh.inp": gmsh_inp}
+        binary_msh = os.path.join(folder, "mesh_binary.msh")
+        subprocess.run(["gmsh", "-2", "-format", "msh41", "-bin",
+                        mesh_formats.GEO, "-o", binary_msh, "-setnumber",
+                        "mixed", "1"], check=True, stdout=subprocess.DEVNULL,
+                       stderr=subprocess.DEVNULL)
+        files = {".msh": msh, "_binary.msh": binary_msh,
+                 "_gmsh.inp": gmsh_inp}
+        files["_parts.inp"] = os.path.join(folder, "mesh_parts.inp")
+        mesh_formats.write_inp_parts(files["_parts.inp"], nodes, cells, lines,
+                                     include=False)
         for suffix, write in ((".inp", mesh_formats.write_inp),
                               (".vtk", mesh_formats.write_vtk),
                               (".ucd", mesh_formats.write_ucd)):
             files[suffix] = os.path.join(folder, "mesh" + suffix)
             write(files[suffix], nodes, cells, lines)
+        # Legacy VTK beside the ASCII 4.2 file: binary 4.2 (big-endian
+        # values after the keyword lines) and meshio's 5.1 layout.
+        files["_42_binary.vtk"] = os.path.join(folder, "mesh_42_binary.vtk")
+        mesh_formats.write_vtk42_binary(files["_42_binary.vtk"], nodes, cells,
+                                        lines, "double")
+        import meshio
+        for name, binary in (("ascii", False), ("binary", True)):
+            suffix = "_meshio_%s.vtk" % name
+            files[suffix] = os.path.join(folder, "mesh" + suffix)
+            meshio.write(files[suffix], meshio.read(msh), binary=binary)
         for encoding in ("ascii", "binary", "binary1", "zlib", "appended"):
             suffix = "_%s.vtu" % encoding
             files[suffix] = os.path.join(folder, "mesh" + suffix)
@@ -96,7 +119,7 @@ def main():
             scene = mesh_formats.SCENE.format(
                 file="@WORK@/mesh" + extension, folder="@WORK@/out",
                 pictures="false", element_sets=element_sets,
-                boundary_sets=boundary_sets)
+                boundary_sets=boundary_sets, **mesh_formats.PHYSICAL_IDS)
             for _ in range(per_file):
                 damaged, what = damage(data, rng)
                 cases.append(("mesh%s: %s" % (suffix, what), scene,

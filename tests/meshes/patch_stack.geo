@@ -5,8 +5,14 @@
 // meshes, node pairs). Physical curves: 1 left sides, 2 right sides,
 // 3 bottom, 4 top, 5 top of the lower block, 6 bottom of the upper block.
 // -setnumber mixed 1: the upper block of quadrilaterals (a mixed mesh).
+// -setnumber groups 1: the contact sides and the top also in physical curve
+// 7, both blocks also in physical surface 3 (entities in two physical
+// groups, as Gmsh allows; the scenes name groups 1-6).
 If (!Exists(mixed))
   mixed = 0;
+EndIf
+If (!Exists(groups))
+  groups = 0;
 EndIf
 lc = 0.3;
 Point(1) = {0, 0, 0, lc}; Point(2) = {1, 0, 0, lc};
@@ -29,3 +35,7 @@ Physical Curve(3) = {1};
 Physical Curve(4) = {7};
 Physical Curve(5) = {3};
 Physical Curve(6) = {5};
+If (groups == 1)
+  Physical Curve(7) = {3, 5, 7};
+  Physical Surface(3) = {1, 2};
+EndIf

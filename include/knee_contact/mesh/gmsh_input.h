@@ -1,6 +1,7 @@
 #ifndef knee_contact_gmsh_input_h
 #define knee_contact_gmsh_input_h
 
+#include <set>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,21 @@ namespace knee_contact
          const std::vector<std::string> &arguments,
          const double                    time_limit);
 
+    /** Whether @p file starts as a binary .msh (file-type 1). */
+    bool
+    is_binary_msh(const std::string &file);
+
+    /**
+     * Write the binary .msh @p binary_msh as the ASCII .msh 4.1 @p msh with
+     * the gmsh program (argument vector, no shell, time limit): deal.II 9.4
+     * reads binary .msh only through the Gmsh API, which Debian's build
+     * lacks. The result is then checked like any .msh.
+     */
+    void
+    convert(const std::string &binary_msh,
+            const std::string &msh,
+            const double       time_limit);
+
     /**
      * Check the structure of an ASCII .msh file (version 2.2 or 4.1)
      * against its header: section order, counts against the file's size,
@@ -54,6 +70,22 @@ namespace knee_contact
      */
     unsigned int
     check_msh(const std::string &file);
+
+    /**
+     * The checked .msh @p msh (2.2 or 4.1) with every entity in one
+     * physical group, as deal.II 9.4 reads it: of an entity's
+     * groups the one the scene names (@p cell_ids for entities of the
+     * cells' dimension @p mesh_dim, @p facet_ids for one dimension less),
+     * or the first if it names none; an entity in two groups the scene
+     * names is refused with a one-line error naming @p file, the entity and
+     * its groups. Returns "" if no entity is in several groups.
+     */
+    std::string
+    one_group_per_entity(const std::string            &msh,
+                         const std::string            &file,
+                         const unsigned int            mesh_dim,
+                         const std::set<unsigned int> &cell_ids,
+                         const std::set<unsigned int> &facet_ids);
   } // namespace gmsh_input
 } // namespace knee_contact
 

@@ -10,6 +10,7 @@
 
 #include <array>
 #include <map>
+#include <set>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -66,6 +67,21 @@ namespace knee_contact
     check_parameters(const std::string &scene_file);
 
     /**
+     * The material ids and boundary ids the scene names (Materials,
+     * conditions, interfaces): of an entity of a Gmsh file in several
+     * physical groups, the one named is read.
+     */
+    void
+    set_scene_ids(const std::set<types::material_id> &material_ids,
+                  const std::set<types::boundary_id> &boundary_ids)
+    {
+      scene_material_ids = material_ids;
+      scene_boundary_ids = boundary_ids;
+      for (const auto &[id, centre] : circular_boundaries)
+        scene_boundary_ids.insert(id);
+    }
+
+    /**
      * Build the coarse mesh, attach the circular manifolds and refine
      * globally as asked.
      */
@@ -112,9 +128,6 @@ namespace knee_contact
     void
     finish(mesh_readers::Description<dim> &mesh,
            Triangulation<dim>             &triangulation) const;
-
-    mesh_readers::Description<2>
-    read_vtk() const;
 
     /** Source = rectangles (2D only: scene_dimension() gives 2). */
     void
@@ -167,6 +180,8 @@ namespace knee_contact
     scene_dimension(const MeshInput<2> &mesh_input,
                     const std::string  &scene_file);
 
+    std::set<types::material_id>             scene_material_ids;
+    std::set<types::boundary_id>             scene_boundary_ids;
     Source                                   source = Source::rectangles;
     std::string                              file;
     std::vector<std::string>                 gmsh_arguments;

@@ -35,7 +35,13 @@ namespace knee_contact
     /**
      * Read an Abaqus input deck (.inp): *Node, *Element (CPS3, CPE3,
      * CPS4, CPE4 and their R/H/I variants), *Elset, *Nset (with or without
-     * GENERATE), *Surface (TYPE=ELEMENT with S1-S4 faces, or TYPE=NODE).
+     * GENERATE), *Surface (TYPE=ELEMENT with S1-S4 faces, or TYPE=NODE),
+     * flat or as Abaqus/CAE writes it: *Part, *Assembly, *Instance (moved
+     * by its translation and rotation lines), sets and surfaces of the
+     * assembly over instances (INSTANCE= or INSTANCE.NAME), *Include,
+     * continued lines. A part's set is INSTANCE.SET, or SET if one
+     * instance has it. *Tie, *Contact Pair, rigid and shell definitions are
+     * refused by name.
      * @p element_sets gives each element set its material id (empty: the
      * element sets of the *Solid Section lines in file order get 1, 2, ...);
      * @p boundary_sets gives a surface or node set its boundary id (a
@@ -62,8 +68,9 @@ namespace knee_contact
     /**
      * Read a VTK XML unstructured grid (.vtu) of one piece: Points, Cells
      * (connectivity, offsets, types: vertices, lines, triangles,
-     * quadrilaterals) and the cell field MaterialID (material ids of cells,
-     * boundary ids of lines), with DataArrays in ascii, inline binary
+     * quadrilaterals) and the ids of cells (material ids) and of lines
+     * (boundary ids) from the first cell field of MaterialID, gmsh:physical,
+     * CellEntityIds, medit:ref, with DataArrays in ascii, inline binary
      * (base64) or raw appended format, uncompressed or zlib-compressed, as
      * ParaView, VTK and meshio write them. Written by hand: deal.II 9.4's
      * read_vtu reads only the files deal.II itself wrote.
@@ -72,13 +79,18 @@ namespace knee_contact
     read_vtu(const std::string &file);
 
     /**
-     * Check a legacy ASCII VTK file (DATASET UNSTRUCTURED_GRID) against its
-     * own counts before deal.II's GridIn::read_vtk, which trusts them:
-     * POINTS, CELLS (vertices, lines, triangles, quadrilaterals), CELL_TYPES
-     * and the CELL_DATA fields MaterialID and ManifoldID (ids < 255).
+     * Read a legacy VTK file (.vtk, DATASET UNSTRUCTURED_GRID) of the 4.2
+     * layout (CELLS as counts and vertices) or the 5.1 layout (OFFSETS and
+     * CONNECTIVITY, as VTK 9, ParaView 5.10 and meshio write it), ASCII or
+     * BINARY (big-endian), points in float or double: vertices, lines,
+     * triangles and quadrilaterals; the ids from the first cell field of
+     * MaterialID, gmsh:physical, CellEntityIds, medit:ref (SCALARS or
+     * FIELD arrays; other attributes, POINT_DATA and VTK 9's METADATA are
+     * skipped). Written by hand: deal.II 9.4's GridIn::read_vtk reads ASCII
+     * 4.2 files only and trusts their counts.
      */
-    void
-    check_vtk(const std::string &file);
+    Description<2>
+    read_vtk(const std::string &file);
 
     /**
      * Split every triangle into three quadrilaterals at its centroid and,

@@ -9,6 +9,7 @@
 
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 
 namespace knee_contact
@@ -106,6 +107,16 @@ namespace knee_contact
 
     double
     min_youngs_modulus() const;
+
+    /** The material ids the scene gives a material. */
+    std::set<types::material_id>
+    ids() const
+    {
+      std::set<types::material_id> result;
+      for (const auto &[id, material] : materials)
+        result.insert(id);
+      return result;
+    }
 
     /**
      * Evaluate the body forces at load parameter @p t from now on.

@@ -3,8 +3,11 @@
 #include <deal.II/grid/grid_tools.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <filesystem>
 #include <map>
+#include <memory>
 #include <set>
 
 namespace knee_contact
@@ -13,50 +16,346 @@ namespace knee_contact
   {
     using namespace internal;
 
+    namespace
+    {
+      /**
+       * The lines of a deck and of the decks it includes (*Include), in
+       * order; errors name the file and line they are in.
+       */
+      class Deck
+      {
+      public:
+        explicit Deck(const std::string &file)
+        {
+          open(file);
+        }
+
+        bool
+        next(std::string &line)
+        {
+          while (!files.empty())
+            {
+              if (files.back()->next(line))
+                return true;
+              last = std::move(files.back());
+              files.pop_back();
+            }
+          return false;
+        }
+
+        /** Continue with @p name (relative to the current file's folder). */
+        void
+        include(const std::string &name)
+        {
+          const std::string path =
+            std::filesystem::path(name).is_absolute()
+              ? name
+              : (std::filesystem::path(current().file).parent_path() / name)
+                  .lexically_normal()
+                  .string();
+          for (const auto &file : files)
+            if (std::filesystem::weakly_canonical(file->file) ==
+                std::filesystem::weakly_canonical(path))
+              fail("*Include of '" + name + "', which includes itself");
+          if (files.size() >= 8)
+            fail("*Include nested more than 8 deep");
+          if (!std::filesystem::is_regular_file(path))
+            fail("*Include: cannot open '" + path + "'");
+          open(path);
+        }
+
+        [[noreturn]] void
+        fail(const std::string &what) const
+        {
+          (files.empty() ? *last : *files.back()).fail(what);
+        }
+
+        /** Bytes of the files read so far: no count may exceed them. */
+        std::uintmax_t size = 0;
+
+        const Lines &
+        current() const
+        {
+          return files.empty() ? *last : *files.back();
+        }
+
+      private:
+        void
+        open(const std::string &file)
+        {
+          files.push_back(std::make_unique<Lines>(file));
+          size += files.back()->size;
+        }
+
+        std::vector<std::unique_ptr<Lines>> files;
+        std::unique_ptr<Lines>              last;
+      };
+
+
+
+      /**
+       * A mesh as the deck defines it: a *Part, or the model as a whole
+       * (the flat deck, and every instance copied into it).
+       */
+      struct Model
+      {
+        std::map<long long, Point<2>>               nodes;
+        std::map<long long, std::vector<long long>> elements;
+        // Two-node line elements (trusses, beams): Gmsh's .inp export
+        // writes the physical curves as these; a set of them names boundary
+        // edges.
+        std::map<long long, std::pair<long long, long long>> line_elements;
+        std::map<std::string, std::set<long long>>           elsets, nsets;
+        // Name -> (element number or element set, face).
+        std::map<std::string, std::vector<std::pair<std::string, unsigned int>>>
+                              surfaces;
+        std::set<std::string> node_surfaces; // TYPE=NODE: node sets
+        // The element sets of *Solid Section lines and their material ids
+        // (1, 2, ... in file order).
+        std::vector<std::pair<std::string, unsigned int>> sections;
+      };
+
+      /**
+       * A *Instance: a copy of a part moved as its data lines say: a
+       * translation, then a rotation about the axis from a to b by an angle
+       * in degrees (Abaqus applies them in this order); in 2D the axis must
+       * be parallel to z.
+       */
+      struct Placement
+      {
+        Tensor<1, 2> translation;
+        Point<2>     centre;
+        double       angle = 0;
+
+        Point<2>
+        operator()(const Point<2> &p) const
+        {
+          const Point<2> moved = p + translation;
+          const double   c = std::cos(angle), s = std::sin(angle);
+          const auto     d = moved - centre;
+          return centre +
+                 Tensor<1, 2>({c * d[0] - s * d[1], s * d[0] + c * d[1]});
+        }
+      };
+    } // namespace
+
+
+
     Description<2>
     read_abaqus(const std::string                         &file,
                 const std::map<std::string, unsigned int> &element_sets,
                 const std::map<std::string, unsigned int> &boundary_sets)
     {
-      Lines lines(file);
-      // Element numbers and node numbers as the deck gives them.
-      std::map<long long, Point<2>>               nodes;
-      std::map<long long, std::vector<long long>> elements;
-      // Two-node line elements (trusses, beams): Gmsh's .inp export writes
-      // the physical curves as these; a set of them names boundary edges.
-      std::map<long long, std::pair<long long, long long>> line_elements;
-      std::map<std::string, std::set<long long>>           elsets, nsets;
-      std::map<std::string, std::vector<std::pair<std::string, unsigned int>>>
-                               surfaces;      // (element or elset, face)
-      std::set<std::string>    node_surfaces; // TYPE=NODE: named as node sets
-      std::vector<std::string> sections;      // element sets, in file order
-      // At most one number per byte of the file: counts beyond that are not
-      // a mesh but an attack on memory.
-      const std::uintmax_t limit = lines.size;
+      Deck deck(file);
+      // The whole model: the flat deck's mesh and every instance's copy,
+      // numbered apart; the sets of an instance are named INSTANCE.SET.
+      Model                        model;
+      std::map<std::string, Model> parts;
+      std::set<std::string>        instance_names;
+      Model                       *scope       = &model; // where definitions go
+      bool                         in_assembly = false;
+      unsigned int                 n_sections  = 0;
+      long long                    next_node   = 0;      // free numbers of
+      long long                    next_element     = 0; // the model
+      const auto                   fail_if_too_many = [&](const Model &m) {
+        // At most one number per byte of the files: counts beyond that are
+        // not a mesh but an attack on memory.
+        if (m.nodes.size() + m.elements.size() + m.line_elements.size() >
+            deck.size)
+          deck.fail("more nodes and elements than the deck can hold");
+      };
 
       std::string  line;
       std::string  block; // the keyword whose data lines follow
       std::string  block_set;
+      std::string  set_instance; // INSTANCE= of an assembly-level set
       bool         generate        = false;
       unsigned int n_element_nodes = 0;
-      while (lines.next(line))
+
+      // "INSTANCE.NAME" of an assembly-level reference: the instance's
+      // copy of a part's set, or an element or node number of the
+      // instance; or a set of the scope.
+      const auto qualified = [&](const std::string &name) {
+        const auto dot = name.find('.');
+        return dot != std::string::npos &&
+               instance_names.count(name.substr(0, dot)) != 0;
+      };
+      // Element and node numbers of instances in the model.
+      std::map<std::string, std::pair<long long, long long>> offsets;
+
+      // Copy @p part as instance @p name into the model, moved by @p place.
+      const auto add_instance = [&](const std::string &name,
+                                    const Model       &part,
+                                    const Placement   &place) {
+        const long long node_offset    = next_node;
+        const long long element_offset = next_element;
+        offsets[name]                  = {node_offset, element_offset};
+        for (const auto &[id, p] : part.nodes)
+          {
+            model.nodes[node_offset + id] = place(p);
+            next_node = std::max(next_node, node_offset + id + 1);
+          }
+        const auto element_id = [&](const long long id) {
+          next_element = std::max(next_element, element_offset + id + 1);
+          return element_offset + id;
+        };
+        for (const auto &[id, nodes] : part.elements)
+          {
+            auto &copy = model.elements[element_id(id)];
+            for (const long long n : nodes)
+              copy.push_back(node_offset + n);
+          }
+        for (const auto &[id, edge] : part.line_elements)
+          model.line_elements[element_id(id)] = {node_offset + edge.first,
+                                                 node_offset + edge.second};
+        for (const auto &[set, ids] : part.elsets)
+          for (const long long id : ids)
+            model.elsets[name + "." + set].insert(element_offset + id);
+        for (const auto &[set, ids] : part.nsets)
+          for (const long long id : ids)
+            model.nsets[name + "." + set].insert(node_offset + id);
+        for (const auto &[surface, faces] : part.surfaces)
+          {
+            auto &copy = model.surfaces[name + "." + surface];
+            for (const auto &[owner, face] : faces)
+              copy.emplace_back(
+                std::isdigit(static_cast<unsigned char>(owner[0]))
+                  ? std::to_string(element_offset + std::stoll(owner))
+                  : name + "." + owner,
+                face);
+          }
+        for (const auto &surface : part.node_surfaces)
+          model.node_surfaces.insert(name + "." + surface);
+        for (const auto &[set, id] : part.sections)
+          model.sections.emplace_back(name + "." + set, id);
+        fail_if_too_many(model);
+      };
+
+      while (deck.next(line))
         {
-          const std::string text = trim(line);
+          std::string text = trim(line);
           if (text.empty() || text.rfind("**", 0) == 0)
             continue;
           if (text[0] == '*')
             {
+              // A keyword line that ends with a comma goes on.
+              std::string more;
+              while (text.back() == ',' && deck.next(more))
+                text += trim(more);
               const auto        keyword_fields = fields(text);
               const std::string keyword        = upper(keyword_fields[0]);
               block                            = "";
-              generate = has_flag(keyword_fields, "GENERATE");
-              if (keyword == "*NODE")
+              set_instance                     = "";
+              generate          = has_flag(keyword_fields, "GENERATE");
+              const auto refuse = [&](const std::string &instead) {
+                deck.fail(keyword_fields[0] +
+                          ": knee_contact does not read "
+                          "it; " +
+                          instead);
+              };
+              if (keyword == "*INCLUDE")
+                {
+                  // The option's value as written (a path keeps its case).
+                  std::string path;
+                  for (std::size_t i = 1; i < keyword_fields.size(); ++i)
+                    {
+                      const auto equal = keyword_fields[i].find('=');
+                      if (equal != std::string::npos &&
+                          upper(trim(keyword_fields[i].substr(0, equal))) ==
+                            "INPUT")
+                        path = trim(keyword_fields[i].substr(equal + 1));
+                    }
+                  if (path.empty())
+                    deck.fail("*Include without INPUT=");
+                  deck.include(path);
+                }
+              else if (keyword == "*PART")
+                {
+                  const std::string name = option(keyword_fields, "NAME");
+                  if (name.empty() || parts.count(name) != 0)
+                    deck.fail("*Part without a name, or a second *Part "
+                              "named '" +
+                              name + "'");
+                  scope = &parts[name];
+                }
+              else if (keyword == "*END PART")
+                {
+                  scope = &model;
+                }
+              else if (keyword == "*ASSEMBLY")
+                in_assembly = true;
+              else if (keyword == "*END ASSEMBLY")
+                in_assembly = false;
+              else if (keyword == "*INSTANCE")
+                {
+                  const std::string name = option(keyword_fields, "NAME");
+                  const std::string part = option(keyword_fields, "PART");
+                  if (!in_assembly || name.empty() || part.empty() ||
+                      parts.count(part) == 0 || instance_names.count(name))
+                    deck.fail("*Instance needs a NAME of its own and the "
+                              "PART of a *Part above, inside *Assembly");
+                  // Up to two data lines (translation; rotation) before
+                  // *End Instance.
+                  Placement                place;
+                  std::vector<std::string> data;
+                  std::string              next;
+                  unsigned int             n_data = 0;
+                  while (deck.next(next))
+                    {
+                      const std::string t = trim(next);
+                      if (t.empty() || t.rfind("**", 0) == 0)
+                        continue;
+                      if (upper(t) == "*END INSTANCE")
+                        break;
+                      if (t[0] == '*')
+                        deck.fail("an *Instance with its own keywords (" +
+                                  fields(t)[0] +
+                                  "): knee_contact reads instances of parts");
+                      const auto v = fields(t);
+                      ++n_data;
+                      if (n_data == 1 && v.size() == 3)
+                        {
+                          place.translation[0] =
+                            to_number(v[0], deck.current());
+                          place.translation[1] =
+                            to_number(v[1], deck.current());
+                          if (to_number(v[2], deck.current()) != 0)
+                            deck.fail("an instance translated along z: "
+                                      "knee_contact meshes lie in the x-y "
+                                      "plane");
+                        }
+                      else if (n_data == 2 && v.size() == 7)
+                        {
+                          std::array<double, 7> r;
+                          for (unsigned int i = 0; i < 7; ++i)
+                            r[i] = to_number(v[i], deck.current());
+                          if (r[0] != r[3] || r[1] != r[4] || r[2] == r[5])
+                            deck.fail("an instance rotated about an axis "
+                                      "that is not parallel to z: "
+                                      "knee_contact meshes lie in the x-y "
+                                      "plane");
+                          place.centre = Point<2>(r[0], r[1]);
+                          place.angle =
+                            (r[5] > r[2] ? 1 : -1) * r[6] * numbers::PI / 180;
+                        }
+                      else
+                        deck.fail("an *Instance data line is a translation "
+                                  "'x, y, z' and then a rotation 'a_x, a_y, "
+                                  "a_z, b_x, b_y, b_z, angle'");
+                    }
+                  instance_names.insert(name);
+                  add_instance(name, parts[part], place);
+                }
+              else if (keyword == "*NODE")
                 {
                   block     = keyword;
                   block_set = option(keyword_fields, "NSET");
                 }
               else if (keyword == "*ELEMENT")
                 {
+                  if (in_assembly)
+                    deck.fail("*Element in the assembly: knee_contact reads "
+                              "elements of parts");
                   const std::string type = option(keyword_fields, "TYPE");
                   const bool        plane =
                     type.rfind("CPS", 0) == 0 || type.rfind("CPE", 0) == 0;
@@ -74,12 +373,12 @@ namespace knee_contact
                   else if (!plane || (n != '3' && n != '4') ||
                            type.find_first_not_of("RHI", 4) !=
                              std::string::npos)
-                    lines.fail(
+                    deck.fail(
                       "element type '" + type +
                       "' is not a linear plane element (knee_contact reads "
                       "CPS3, CPE3, CPS4, CPE4 and their R, H, I variants, "
                       "and two-node lines T2D2, T3D2, B21, B31 as boundary "
-                      "edges)");
+                      "edges; mesh with linear elements)");
                   else
                     n_element_nodes = n - '0';
                   block     = keyword;
@@ -91,138 +390,207 @@ namespace knee_contact
                   block_set = option(keyword_fields,
                                      keyword == "*ELSET" ? "ELSET" : "NSET");
                   if (block_set.empty())
-                    lines.fail(keyword + " without a name");
-                  (keyword == "*ELSET" ? elsets : nsets)[block_set];
+                    deck.fail(keyword + " without a name");
+                  set_instance = option(keyword_fields, "INSTANCE");
+                  if (!set_instance.empty() &&
+                      (!in_assembly || offsets.count(set_instance) == 0))
+                    deck.fail(keyword + " of instance '" + set_instance +
+                              "', which no *Instance above defines");
+                  (keyword == "*ELSET" ? scope->elsets
+                                       : scope->nsets)[block_set];
                 }
               else if (keyword == "*SURFACE")
                 {
                   block_set = option(keyword_fields, "NAME");
                   if (block_set.empty())
-                    lines.fail("*Surface without a name");
+                    deck.fail("*Surface without a name");
                   const std::string type = option(keyword_fields, "TYPE");
                   if (type == "NODE")
                     {
                       block = "*NSET";
-                      nsets[block_set];
-                      node_surfaces.insert(block_set);
+                      scope->nsets[block_set];
+                      scope->node_surfaces.insert(block_set);
                     }
                   else if (type.empty() || type == "ELEMENT")
                     {
                       block = keyword;
-                      surfaces[block_set];
+                      scope->surfaces[block_set];
                     }
                   else
-                    lines.fail("*Surface type '" + type +
-                               "' (knee_contact reads ELEMENT and NODE)");
+                    refuse("*Surface, type=" + type +
+                           " is a rigid (analytical) surface: model the "
+                           "rigid body as a stiff body of the mesh or as a "
+                           "displacement condition");
                 }
               else if (keyword == "*SOLID SECTION")
                 {
                   const std::string set = option(keyword_fields, "ELSET");
                   if (set.empty())
-                    lines.fail("*Solid Section without ELSET");
-                  sections.push_back(set);
+                    deck.fail("*Solid Section without ELSET");
+                  scope->sections.emplace_back(set, ++n_sections);
                 }
-              else if (keyword == "*PART" && !nodes.empty())
-                lines.fail("a second *Part: knee_contact reads one part "
-                           "(export the model flat, without parts and "
-                           "instances)");
-              else if (keyword == "*INSTANCE")
-                {
-                  // An instance may move its part: read it only if it does
-                  // not (the next line ends it).
-                  std::string next;
-                  if (lines.next(next) && upper(trim(next)) != "*END INSTANCE")
-                    lines.fail("an *Instance that moves its part: knee_contact "
-                               "reads parts in place (export the model flat)");
-                }
+              else if (keyword == "*SHELL SECTION" ||
+                       keyword == "*MEMBRANE SECTION")
+                refuse("shells and membranes are not plane solids: mesh the "
+                       "body with CPE/CPS elements");
+              else if (keyword == "*RIGID BODY")
+                refuse("model the rigid body as a stiff body of the mesh or "
+                       "as a displacement condition (Boundary conditions)");
+              else if (keyword == "*TIE")
+                refuse("bodies that share nodes are bonded: merge the tied "
+                       "surfaces' nodes, or make the two sides a contact "
+                       "interface");
+              else if (keyword == "*CONTACT PAIR" || keyword == "*CONTACT" ||
+                       keyword == "*SURFACE INTERACTION")
+                refuse("contact is defined in the scene: name the surfaces "
+                       "in Mesh/Abaqus boundary sets and pair them in "
+                       "Contact/Interface N (remove the deck's contact "
+                       "definitions)");
               // Every other keyword (materials, steps, loads, ...) and its
               // data is not mesh: skipped.
               continue;
             }
 
-          const auto values = fields(text);
+          auto values = fields(text);
           if (block == "*NODE")
             {
               if (values.size() < 3 || values.size() > 4)
-                lines.fail("a node needs 'number, x, y' (found " +
-                           std::to_string(values.size()) + " fields)");
-              const long long id = to_integer(values[0], lines);
-              const Point<2>  p(to_number(values[1], lines),
-                               to_number(values[2], lines));
-              if (values.size() == 4 && to_number(values[3], lines) != 0)
-                lines.fail("node " + values[0] +
-                           " has z != 0: knee_contact meshes lie in the "
-                           "x-y plane");
-              if (!nodes.emplace(id, p).second)
-                lines.fail("node " + values[0] + " appears twice");
-              if (nodes.size() > limit)
-                lines.fail("more nodes than the file can hold");
+                deck.fail("a node needs 'number, x, y' (found " +
+                          std::to_string(values.size()) + " fields)");
+              const long long id = to_integer(values[0], deck.current());
+              if (id < 0 || id > (1ll << 40))
+                deck.fail("node number " + values[0] + " out of range");
+              const Point<2> p(to_number(values[1], deck.current()),
+                               to_number(values[2], deck.current()));
+              if (values.size() == 4 &&
+                  to_number(values[3], deck.current()) != 0)
+                deck.fail("node " + values[0] +
+                          " has z != 0: knee_contact meshes lie in the x-y "
+                          "plane");
+              // Nodes of the assembly are reference points of rigid
+              // bodies (refused where they are defined): not mesh.
+              if (in_assembly)
+                continue;
+              if (!scope->nodes.emplace(id, p).second)
+                deck.fail("node " + values[0] + " appears twice");
+              if (scope == &model)
+                next_node = std::max(next_node, id + 1);
+              fail_if_too_many(*scope);
               if (!block_set.empty())
-                nsets[block_set].insert(id);
+                scope->nsets[block_set].insert(id);
             }
           else if (block == "*ELEMENT")
             {
+              // An element's node list may go on over lines that end
+              // with a comma.
+              std::string more;
+              while (values.size() < n_element_nodes + 1 &&
+                     text.back() == ',' && deck.next(more))
+                {
+                  text += trim(more);
+                  values = fields(text);
+                }
               if (values.size() != n_element_nodes + 1)
-                lines.fail("element needs its number and " +
-                           std::to_string(n_element_nodes) +
-                           " node numbers on one line (found " +
-                           std::to_string(values.size()) + " fields)");
-              const long long        id = to_integer(values[0], lines);
+                deck.fail("element needs its number and " +
+                          std::to_string(n_element_nodes) +
+                          " node numbers (found " +
+                          std::to_string(values.size()) + " fields)");
+              const long long id = to_integer(values[0], deck.current());
+              if (id < 0 || id > (1ll << 40))
+                deck.fail("element number " + values[0] + " out of range");
               std::vector<long long> element;
               for (unsigned int k = 1; k < values.size(); ++k)
                 {
-                  element.push_back(to_integer(values[k], lines));
-                  if (nodes.count(element.back()) == 0)
-                    lines.fail("element " + values[0] + " refers to node " +
-                               values[k] + ", which no *Node line gives");
+                  element.push_back(to_integer(values[k], deck.current()));
+                  if (scope->nodes.count(element.back()) == 0)
+                    deck.fail("element " + values[0] + " refers to node " +
+                              values[k] + ", which no *Node line gives");
                 }
               if (std::set<long long>(element.begin(), element.end()).size() !=
                   element.size())
-                lines.fail("element " + values[0] + " names a node twice");
-              if (elements.count(id) != 0 || line_elements.count(id) != 0)
-                lines.fail("element " + values[0] + " appears twice");
+                deck.fail("element " + values[0] + " names a node twice");
+              if (scope->elements.count(id) != 0 ||
+                  scope->line_elements.count(id) != 0)
+                deck.fail("element " + values[0] + " appears twice");
               if (element.size() == 2)
-                line_elements.emplace(id, std::minmax(element[0], element[1]));
+                scope->line_elements.emplace(id,
+                                             std::minmax(element[0],
+                                                         element[1]));
               else
-                elements.emplace(id, element);
+                scope->elements.emplace(id, element);
+              if (scope == &model)
+                next_element = std::max(next_element, id + 1);
+              fail_if_too_many(*scope);
               if (!block_set.empty())
-                elsets[block_set].insert(id);
+                scope->elsets[block_set].insert(id);
             }
           else if (block == "*ELSET" || block == "*NSET")
             {
-              auto &set = (block == "*ELSET" ? elsets : nsets)[block_set];
+              const bool elements = block == "*ELSET";
+              auto &set = (elements ? scope->elsets : scope->nsets)[block_set];
+              // Numbers of instance INSTANCE= are shifted into the model's.
+              const long long shift =
+                set_instance.empty() ? 0
+                                     : (elements ? offsets[set_instance].second
+                                                 : offsets[set_instance].first);
               if (generate)
                 {
                   if (values.size() < 2 || values.size() > 3)
-                    lines.fail("GENERATE needs 'first, last[, step]'");
-                  const long long first = to_integer(values[0], lines),
-                                  last  = to_integer(values[1], lines),
-                                  step  = values.size() == 3
-                                            ? to_integer(values[2], lines)
-                                            : 1;
+                    deck.fail("GENERATE needs 'first, last[, step]'");
+                  const long long first = to_integer(values[0], deck.current()),
+                                  last  = to_integer(values[1], deck.current()),
+                                  step =
+                                    values.size() == 3
+                                      ? to_integer(values[2], deck.current())
+                                      : 1;
                   if (step <= 0 || last < first ||
-                      (last - first) / step > static_cast<long long>(limit))
-                    lines.fail("GENERATE range '" + text +
-                               "' is empty or too long");
+                      (last - first) / step > static_cast<long long>(deck.size))
+                    deck.fail("GENERATE range '" + text +
+                              "' is empty or too long");
                   for (long long i = first; i <= last; i += step)
-                    set.insert(i);
+                    set.insert(shift + i);
                 }
               else
                 for (const auto &value : values)
                   {
-                    if (!value.empty() &&
-                        !std::isdigit(static_cast<unsigned char>(value[0])))
+                    const std::string name = upper(value);
+                    const auto &sets = elements ? scope->elsets : scope->nsets;
+                    if (qualified(name) && set_instance.empty() && in_assembly)
+                      {
+                        // INSTANCE.number or INSTANCE.SET.
+                        const auto        dot      = name.find('.');
+                        const std::string instance = name.substr(0, dot);
+                        const std::string member   = name.substr(dot + 1);
+                        if (std::isdigit(static_cast<unsigned char>(member[0])))
+                          set.insert((elements ? offsets[instance].second
+                                               : offsets[instance].first) +
+                                     to_integer(member, deck.current()));
+                        else
+                          {
+                            const auto it = sets.find(name);
+                            if (it == sets.end())
+                              deck.fail("set '" + value +
+                                        "' is not defined in its part");
+                            set.insert(it->second.begin(), it->second.end());
+                          }
+                      }
+                    else if (!value.empty() &&
+                             !std::isdigit(
+                               static_cast<unsigned char>(value[0])))
                       {
                         // A set made of other sets.
-                        const auto &sets = block == "*ELSET" ? elsets : nsets;
-                        const auto  it   = sets.find(upper(value));
+                        const auto it = sets.find(name);
                         if (it == sets.end())
-                          lines.fail("set '" + value +
-                                     "' is not defined above");
+                          deck.fail("set '" + value + "' is not defined above");
                         set.insert(it->second.begin(), it->second.end());
                       }
+                    else if (in_assembly && set_instance.empty())
+                      deck.fail("an assembly set names " + value +
+                                " without its instance (write "
+                                "INSTANCE." +
+                                value + " or give INSTANCE=)");
                     else
-                      set.insert(to_integer(value, lines));
+                      set.insert(shift + to_integer(value, deck.current()));
                   }
             }
           else if (block == "*SURFACE")
@@ -230,33 +598,66 @@ namespace knee_contact
               if (values.size() != 2 || values[1].size() != 2 ||
                   std::toupper(values[1][0]) != 'S' || values[1][1] < '1' ||
                   values[1][1] > '4')
-                lines.fail("a surface line needs 'element or element set, "
-                           "S1..S4'");
-              surfaces[block_set].emplace_back(upper(values[0]),
-                                               values[1][1] - '1');
+                deck.fail("a surface line needs 'element or element set, "
+                          "S1..S4'");
+              if (in_assembly &&
+                  std::isdigit(static_cast<unsigned char>(values[0][0])))
+                deck.fail("a surface of the assembly names element " +
+                          values[0] +
+                          " without its instance (write INSTANCE.SET)");
+              scope->surfaces[block_set].emplace_back(upper(values[0]),
+                                                      values[1][1] - '1');
             }
         }
-      AssertThrow(!elements.empty(),
+      if (!parts.empty() && instance_names.empty())
+        deck.fail("the deck defines parts but no *Instance of them");
+      AssertThrow(!model.elements.empty(),
                   ExcMessage("Mesh/File: '" + file +
                              "' has no *Element lines with plane elements"));
 
+      // A set the scene names: as written (upper case), or the one
+      // instance's copy of it if only one instance has it.
+      const auto find_name = [&](const std::string &name,
+                                 const auto        &sets) -> std::string {
+        const std::string key = upper(name);
+        if (sets.count(key) != 0 || key.find('.') != std::string::npos)
+          return key;
+        std::vector<std::string> copies;
+        for (const auto &[set, members] : sets)
+          if (set.size() > key.size() + 1 &&
+              set.compare(set.size() - key.size() - 1,
+                          std::string::npos,
+                          "." + key) == 0)
+            copies.push_back(set);
+        if (copies.size() > 1)
+          AssertThrow(false,
+                      ExcMessage("Mesh/File: '" + file + "': the set '" + name +
+                                 "' is in several instances (" + copies[0] +
+                                 ", " + copies[1] +
+                                 "); name one as INSTANCE.SET in the scene"));
+        return copies.empty() ? key : copies[0];
+      };
+
       // Material ids.
-      std::map<std::string, unsigned int> material_of_set = element_sets;
-      if (material_of_set.empty())
-        for (unsigned int i = 0; i < sections.size(); ++i)
-          material_of_set.emplace(upper(sections[i]), i + 1);
+      std::map<std::string, unsigned int> material_of_set;
+      if (element_sets.empty())
+        for (const auto &[set, id] : model.sections)
+          material_of_set.emplace(set, id);
+      else
+        for (const auto &[name, id] : element_sets)
+          material_of_set.emplace(find_name(name, model.elsets), id);
       std::map<long long, unsigned int> material;
       for (const auto &[name, id] : material_of_set)
         {
-          const auto set = elsets.find(upper(name));
-          AssertThrow(set != elsets.end(),
+          const auto set = model.elsets.find(name);
+          AssertThrow(set != model.elsets.end(),
                       ExcMessage("Mesh/Abaqus element sets: '" + file +
                                  "' has no element set '" + name + "'"));
           for (const long long e : set->second)
             {
-              if (line_elements.count(e) != 0)
+              if (model.line_elements.count(e) != 0)
                 continue; // boundary edges, not cells
-              AssertThrow(elements.count(e) != 0,
+              AssertThrow(model.elements.count(e) != 0,
                           ExcMessage("Mesh/File: '" + file +
                                      "': element set '" + name +
                                      "' names element " + std::to_string(e) +
@@ -269,7 +670,7 @@ namespace knee_contact
                                      "material ids"));
             }
         }
-      for (const auto &element : elements)
+      for (const auto &element : model.elements)
         AssertThrow(material.count(element.first) != 0,
                     ExcMessage("Mesh/Abaqus element sets: element " +
                                std::to_string(element.first) + " of '" + file +
@@ -281,12 +682,12 @@ namespace knee_contact
 
       Description<2>                    mesh;
       std::map<long long, unsigned int> vertex_of_node;
-      for (const auto &[id, p] : nodes)
+      for (const auto &[id, p] : model.nodes)
         {
           vertex_of_node[id] = mesh.vertices.size();
           mesh.vertices.push_back(p);
         }
-      for (const auto &[id, element] : elements)
+      for (const auto &[id, element] : model.elements)
         {
           std::vector<unsigned int> vertices;
           for (const long long node : element)
@@ -298,7 +699,7 @@ namespace knee_contact
       // in a node set; only faces on the boundary (one element) count.
       std::map<std::pair<long long, long long>, unsigned int>
         n_elements_of_edge;
-      for (const auto &[id, element] : elements)
+      for (const auto &[id, element] : model.elements)
         for (unsigned int k = 0; k < element.size(); ++k)
           {
             auto e = face_nodes(element, k);
@@ -307,28 +708,35 @@ namespace knee_contact
       std::map<std::pair<long long, long long>, unsigned int> boundary_id;
       for (const auto &[name, id] : boundary_sets)
         {
-          const std::string key    = upper(name);
-          const auto        before = boundary_id.size();
-          if (surfaces.count(key) != 0)
-            for (const auto &[owner, face] : surfaces[key])
+          // A surface, else a set of line elements, else a node set.
+          std::string key = find_name(name, model.surfaces);
+          if (model.surfaces.count(key) == 0)
+            {
+              key = find_name(name, model.elsets);
+              if (model.elsets.count(key) == 0)
+                key = find_name(name, model.nsets);
+            }
+          const auto before = boundary_id.size();
+          if (model.surfaces.count(key) != 0)
+            for (const auto &[owner, face] : model.surfaces[key])
               {
                 std::set<long long> owners;
                 if (std::isdigit(static_cast<unsigned char>(owner[0])))
                   owners.insert(std::stoll(owner));
                 else
                   {
-                    AssertThrow(elsets.count(owner) != 0,
+                    AssertThrow(model.elsets.count(owner) != 0,
                                 ExcMessage("Mesh/File: '" + file +
                                            "': surface '" + name +
                                            "' names element set '" + owner +
                                            "', which is not defined"));
-                    owners = elsets[owner];
+                    owners = model.elsets[owner];
                   }
                 for (const long long e : owners)
                   {
-                    const auto element = elements.find(e);
+                    const auto element = model.elements.find(e);
                     AssertThrow(
-                      element != elements.end() &&
+                      element != model.elements.end() &&
                         face < element->second.size(),
                       ExcMessage("Mesh/File: '" + file + "': surface '" + name +
                                  "' names face S" + std::to_string(face + 1) +
@@ -338,17 +746,17 @@ namespace knee_contact
                     boundary_id[std::minmax(edge.first, edge.second)] = id;
                   }
               }
-          else if (elsets.count(key) != 0 && !elsets[key].empty() &&
-                   std::all_of(elsets[key].begin(),
-                               elsets[key].end(),
+          else if (model.elsets.count(key) != 0 && !model.elsets[key].empty() &&
+                   std::all_of(model.elsets[key].begin(),
+                               model.elsets[key].end(),
                                [&](const long long e) {
-                                 return line_elements.count(e) != 0;
+                                 return model.line_elements.count(e) != 0;
                                }))
-            for (const long long e : elsets[key])
-              boundary_id[line_elements[e]] = id;
-          else if (nsets.count(key) != 0)
+            for (const long long e : model.elsets[key])
+              boundary_id[model.line_elements[e]] = id;
+          else if (model.nsets.count(key) != 0)
             {
-              const auto &set = nsets[key];
+              const auto &set = model.nsets[key];
               for (const auto &[edge, n] : n_elements_of_edge)
                 if (n == 1 && set.count(edge.first) && set.count(edge.second))
                   boundary_id[edge] = id;

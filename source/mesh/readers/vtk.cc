@@ -1,146 +1,584 @@
 #include <knee_contact/mesh/readers/line_reader.h>
 
-#include <deal.II/grid/grid_tools.h>
-
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <functional>
+#include <map>
 
+// The legacy VTK format (.vtk), written by hand: deal.II 9.4's
+// GridIn::read_vtk reads ASCII files of the 4.2 layout only and trusts their
+// counts, while VTK 9, ParaView 5.10 and meshio write the 5.1 layout
+// (CELLS as OFFSETS and CONNECTIVITY arrays) and meshio writes binary by
+// default.
 namespace knee_contact
 {
   namespace mesh_readers
   {
     using namespace internal;
 
-    void
-    check_vtk(const std::string &file)
+    namespace
     {
-      Lines       lines(file);
-      std::string line;
-      const auto  expect_line = [&](const std::string &what) {
-        if (!lines.next(line))
-          lines.fail("the file ends where " + what + " should be");
-        return trim(line);
-      };
-      if (expect_line("the header").rfind("# vtk DataFile Version", 0) != 0)
-        lines.fail("not a legacy VTK file (no '# vtk DataFile Version' "
-                   "header; knee_contact reads ASCII .vtk, not .vtu)");
-      expect_line("the title");
-      if (upper(expect_line("ASCII")) != "ASCII")
-        lines.fail("a binary VTK file: knee_contact reads ASCII .vtk");
-      if (upper(expect_line("DATASET")) != "DATASET UNSTRUCTURED_GRID")
-        lines.fail("DATASET is not UNSTRUCTURED_GRID");
-
-      // The rest as whitespace separated words, with their lines.
-      std::vector<std::pair<std::string, unsigned long>> words;
-      while (lines.next(line))
+      /**
+       * A legacy VTK file in memory: keyword lines are text, data are
+       * whitespace separated numbers (ASCII) or big-endian values right after
+       * the keyword line (BINARY). Errors name the file and line.
+       */
+      class LegacyFile
+      {
+      public:
+        explicit LegacyFile(const std::string &file)
+          : file(file)
         {
-          std::stringstream stream(line);
-          std::string       word;
-          while (stream >> word)
-            words.emplace_back(word, lines.number);
+          std::ifstream in(file, std::ios::binary);
+          AssertThrow(in.good(),
+                      ExcMessage("Mesh/File: cannot open '" + file + "'"));
+          const std::uintmax_t size = std::filesystem::file_size(file);
+          text.resize(size);
+          in.read(text.data(), size);
+          AssertThrow(in.good() || in.eof(),
+                      ExcMessage("Mesh/File: cannot read '" + file + "'"));
         }
-      std::size_t at   = 0;
-      const auto  word = [&](const std::string &what) -> const std::string  &{
-        if (at >= words.size())
-          lines.fail("the file ends where " + what + " should be");
-        lines.number = words[at].second;
-        return words[at++].first;
-      };
-      const auto count = [&](const std::string &what) {
-        const std::string &text = word(what);
-        const long long    n    = to_integer(text, lines);
-        if (n < 0 || static_cast<std::uintmax_t>(n) > lines.size)
-          lines.fail(what + " " + text + " is more than the file's " +
-                     std::to_string(lines.size) + " bytes can hold");
-        return static_cast<std::size_t>(n);
-      };
-      const auto keyword = [&](const std::string &expected) {
-        const std::string &found = word(expected);
-        if (upper(found) != expected)
-          lines.fail("expected " + expected + ", found '" + found + "'");
-      };
 
-      keyword("POINTS");
-      const std::size_t n_points = count("point count");
-      word("the point type");
-      for (std::size_t i = 0; i < 3 * n_points; ++i)
-        to_number(word("a coordinate"), lines);
-      keyword("CELLS");
-      const std::size_t        n_cells = count("cell count");
-      const std::size_t        n_ints  = count("cell list size");
-      std::vector<std::size_t> sizes;
-      std::size_t              used = 0;
-      for (std::size_t c = 0; c < n_cells; ++c)
+        [[noreturn]] void
+        fail(const std::string &what) const
         {
-          const std::size_t n = count("vertex count");
-          if (n < 1 || n > 4)
-            lines.fail("cell " + std::to_string(c) + " has " +
-                       std::to_string(n) + " vertices");
-          std::set<long long> distinct;
-          for (std::size_t k = 0; k < n; ++k)
+          throw std::runtime_error(
+            input::cap("Mesh/File: '" + file + "' line " +
+                       std::to_string(line_number) + ": " + what));
+        }
+
+        /** The next line, without its end; false at the end of the file. */
+        bool
+        line(std::string &result)
+        {
+          if (at >= text.size())
+            return false;
+          const auto end = std::min(text.find('\n', at), text.size());
+          result         = text.substr(at, end - at);
+          if (!result.empty() && result.back() == '\r')
+            result.pop_back();
+          line_number = newlines + 1;
+          if (end < text.size())
+            ++newlines;
+          at = std::min(end + 1, text.size());
+          return true;
+        }
+
+        /** The next line that is not blank, split into words. */
+        std::vector<std::string>
+        keyword_line(const std::string &what)
+        {
+          std::string text_line;
+          while (line(text_line))
             {
-              const long long v = to_integer(word("a vertex"), lines);
-              if (v < 0 || static_cast<std::size_t>(v) >= n_points)
-                lines.fail("cell " + std::to_string(c) + " refers to point " +
-                           std::to_string(v) + ", but there are " +
-                           std::to_string(n_points) + " points");
-              distinct.insert(v);
+              std::vector<std::string> words;
+              std::stringstream        stream(text_line);
+              std::string              word;
+              while (stream >> word)
+                words.push_back(word);
+              if (!words.empty())
+                return words;
             }
-          if (distinct.size() != n)
-            lines.fail("cell " + std::to_string(c) + " names a point twice");
-          sizes.push_back(n);
-          used += n + 1;
+          fail("the file ends where " + what + " should be");
         }
-      if (used != n_ints)
-        lines.fail("CELLS says " + std::to_string(n_ints) +
-                   " numbers, the cells have " + std::to_string(used));
-      keyword("CELL_TYPES");
-      if (count("cell type count") != n_cells)
-        lines.fail("CELL_TYPES count differs from CELLS");
-      for (std::size_t c = 0; c < n_cells; ++c)
+
+        /**
+         * Whether the next word (after white space) is @p word, without
+         * reading it.
+         */
+        bool
+        next_is(const std::string &word) const
         {
-          const long long type = to_integer(word("a cell type"), lines);
-          // 1 vertex, 3 line, 5 triangle, 9 quadrilateral.
-          const std::map<long long, std::size_t> n_vertices = {{1, 1},
-                                                               {3, 2},
-                                                               {5, 3},
-                                                               {9, 4}};
-          if (n_vertices.count(type) == 0)
-            lines.fail("cell type " + std::to_string(type) +
-                       " is not a vertex (1), line (3), triangle (5) or "
-                       "quadrilateral (9); knee_contact reads linear 2D "
-                       "cells");
-          if (n_vertices.at(type) != sizes[c])
-            lines.fail("cell " + std::to_string(c) + " of type " +
-                       std::to_string(type) + " has " +
-                       std::to_string(sizes[c]) + " vertices");
+          std::size_t p = at;
+          while (p < text.size() &&
+                 std::isspace(static_cast<unsigned char>(text[p])))
+            ++p;
+          if (p >= text.size())
+            return false;
+          return upper(text.substr(p, word.size())) == word &&
+                 (p + word.size() == text.size() ||
+                  std::isspace(
+                    static_cast<unsigned char>(text[p + word.size()])));
         }
-      if (at == words.size())
-        return;
-      keyword("CELL_DATA");
-      if (count("cell data count") != n_cells)
-        lines.fail("CELL_DATA count differs from CELLS");
-      while (at < words.size())
+
+        bool
+        at_end()
         {
-          keyword("SCALARS");
-          const std::string name = word("a field name");
-          if (name != "MaterialID" && name != "ManifoldID")
-            lines.fail("field '" + name +
-                       "': knee_contact reads MaterialID and ManifoldID "
-                       "(boundary ids are the MaterialID of line cells)");
-          if (word("the field type") != "int")
-            lines.fail("field '" + name + "' must have type int");
-          if (words[at].first == "1")
+          while (at < text.size() &&
+                 std::isspace(static_cast<unsigned char>(text[at])))
+            {
+              if (text[at] == '\n')
+                ++newlines;
+              ++at;
+            }
+          return at >= text.size();
+        }
+
+        /**
+         * A count from a keyword line: a non-negative integer no larger than
+         * the file's size (each value takes at least a byte), so that
+         * nothing is allocated for a count the file cannot hold.
+         */
+        std::size_t
+        count(const std::string &word, const std::string &what) const
+        {
+          std::size_t end   = 0;
+          long long   value = -1;
+          try
+            {
+              value = std::stoll(word, &end);
+            }
+          catch (...)
+            {
+              end = 0;
+            }
+          if (end == 0 || end != word.size() || value < 0)
+            fail(what + " '" + word + "' is not a count");
+          if (static_cast<std::uintmax_t>(value) > text.size())
+            fail(what + " " + word + " is more than the file's " +
+                 std::to_string(text.size()) + " bytes can hold");
+          return static_cast<std::size_t>(value);
+        }
+
+        /**
+         * @p n values of the VTK data type @p type, as doubles (ids and
+         * counts are integers far below 2^53).
+         */
+        std::vector<double>
+        values(const std::size_t  n,
+               const std::string &type,
+               const std::string &section)
+        {
+          // Bytes per value in BINARY files; "long" is 8 bytes as VTK and
+          // meshio write it on 64-bit Linux.
+          static const std::map<std::string, unsigned int> sizes = {
+            {"unsigned_char", 1},
+            {"char", 1},
+            {"unsigned_short", 2},
+            {"short", 2},
+            {"unsigned_int", 4},
+            {"int", 4},
+            {"vtktypeint32", 4},
+            {"vtktypeuint32", 4},
+            {"unsigned_long", 8},
+            {"long", 8},
+            {"vtktypeint64", 8},
+            {"vtktypeuint64", 8},
+            {"float", 4},
+            {"double", 8}};
+          const auto size = sizes.find(type);
+          if (size == sizes.end())
+            fail("data type '" + type +
+                 "' (knee_contact reads char, short, int, long, their "
+                 "unsigned kinds, vtktypeint32/64, float and double)");
+          std::vector<double> result;
+          if (binary)
+            {
+              const std::size_t bytes = size->second;
+              if (n > (text.size() - at) / bytes)
+                fail(section + ": " + std::to_string(n) + " values of type " +
+                     type + " are more than the rest of the file holds");
+              result.resize(n);
+              for (std::size_t i = 0; i < n; ++i)
+                result[i] =
+                  binary_value(text.data() + at + i * bytes, type, bytes);
+              at += n * bytes;
+            }
+          else
+            {
+              if (n > text.size() - at)
+                fail(section + ": " + std::to_string(n) +
+                     " values are more than the rest of the file holds");
+              result.reserve(n);
+              for (std::size_t i = 0; i < n; ++i)
+                {
+                  const std::string word = ascii_word();
+                  if (word.empty())
+                    fail("the file ends inside " + section + " (value " +
+                         std::to_string(i + 1) + " of " + std::to_string(n) +
+                         ")");
+                  const auto value = input::number(word);
+                  if (!value)
+                    fail("'" + word + "' is not a finite number");
+                  result.push_back(*value);
+                }
+            }
+          return result;
+        }
+
+        /**
+         * Skip VTK 9's METADATA block after an array (component names and
+         * information keys), which ends at a blank line.
+         */
+        void
+        skip_metadata()
+        {
+          // Binary data end with a newline that is not white space of a
+          // line (it may be the first byte of nothing else).
+          if (binary && at < text.size() && text[at] == '\n')
+            {
+              ++at;
+              ++newlines;
+            }
+          if (!next_is("METADATA"))
+            return;
+          std::string next;
+          while (line(next) && trim(next).empty())
+            ;
+          // METADATA itself, then its lines up to a blank one.
+          while (line(next) && !trim(next).empty())
+            ;
+        }
+
+        const std::string file;
+        bool              binary = false;
+        /** The line of what was read last, for messages. */
+        unsigned long line_number = 0;
+
+      private:
+        std::string
+        ascii_word()
+        {
+          while (at < text.size() &&
+                 std::isspace(static_cast<unsigned char>(text[at])))
+            {
+              if (text[at] == '\n')
+                ++newlines;
+              ++at;
+            }
+          if (at < text.size())
+            line_number = newlines + 1;
+          const std::size_t start = at;
+          while (at < text.size() &&
+                 !std::isspace(static_cast<unsigned char>(text[at])))
             ++at;
-          keyword("LOOKUP_TABLE");
-          word("the lookup table");
-          for (std::size_t c = 0; c < n_cells; ++c)
-            {
-              const long long id = to_integer(word("an id"), lines);
-              if (id < 0 || id >= 255)
-                lines.fail(name + " " + std::to_string(id) +
-                           " is not in 0..254");
-            }
+          return text.substr(start, at - start);
         }
+
+        static double
+        binary_value(const char        *data,
+                     const std::string &type,
+                     const unsigned int bytes)
+        {
+          // Big-endian, as the format defines.
+          std::uint64_t bits = 0;
+          for (unsigned int b = 0; b < bytes; ++b)
+            bits = (bits << 8) | static_cast<unsigned char>(data[b]);
+          if (type == "float")
+            {
+              const auto u = static_cast<std::uint32_t>(bits);
+              float      f;
+              std::memcpy(&f, &u, 4);
+              return f;
+            }
+          if (type == "double")
+            {
+              double d;
+              std::memcpy(&d, &bits, 8);
+              return d;
+            }
+          const bool is_signed =
+            type == "char" || type == "short" || type == "int" ||
+            type == "long" || type == "vtktypeint32" || type == "vtktypeint64";
+          if (is_signed && bytes < 8 && (bits >> (8 * bytes - 1)) != 0)
+            return static_cast<double>(static_cast<std::int64_t>(bits) -
+                                       (std::int64_t(1) << (8 * bytes)));
+          if (is_signed)
+            return static_cast<double>(static_cast<std::int64_t>(bits));
+          return static_cast<double>(bits);
+        }
+
+        std::string text;
+        std::size_t at = 0;
+        /** Line ends before at (binary data are not counted). */
+        unsigned long newlines = 0;
+      };
+
+
+
+      /**
+       * Read the arrays of the FIELD whose keyword line is @p words, each of
+       * @p n tuples (any number if @p n is std::size_t(-1): a field of the
+       * whole data set), and give each to @p keep (name, components,
+       * values).
+       */
+      void
+      read_field(LegacyFile                                        &vtk,
+                 const std::vector<std::string>                    &words,
+                 const std::size_t                                  n,
+                 const std::function<void(const std::string &,
+                                          const unsigned int,
+                                          std::vector<double> &&)> &keep)
+      {
+        if (words.size() < 3)
+          vtk.fail("FIELD needs a name and an array count");
+        const std::size_t n_arrays = vtk.count(words[2], "FIELD array count");
+        for (std::size_t a = 0; a < n_arrays; ++a)
+          {
+            const auto array = vtk.keyword_line("a FIELD array");
+            if (array.size() < 4)
+              vtk.fail("a FIELD array needs a name, components, tuples and "
+                       "a data type");
+            const std::size_t n_components =
+              vtk.count(array[1], "component count");
+            const std::size_t n_tuples = vtk.count(array[2], "tuple count");
+            if (n != std::size_t(-1) && n_tuples != n)
+              vtk.fail("FIELD array '" + array[0] + "' has " + array[2] +
+                       " tuples, its section " + std::to_string(n));
+            if (n_components < 1 ||
+                (n_tuples > 0 && n_components > std::size_t(-1) / n_tuples))
+              vtk.fail("FIELD array '" + array[0] + "' has " + array[1] +
+                       " components");
+            keep(array[0],
+                 static_cast<unsigned int>(n_components),
+                 vtk.values(n_components * n_tuples,
+                            array[3],
+                            "FIELD array " + array[0]));
+            vtk.skip_metadata();
+          }
+      }
+
+
+
+      /**
+       * Read the attributes of a CELL_DATA or POINT_DATA section of @p n
+       * tuples until the next section; keep the cell field named in
+       * id_field_names() that comes first in that list in @p ids.
+       */
+      void
+      read_attributes(LegacyFile               &vtk,
+                      const std::size_t         n,
+                      const bool                cells,
+                      std::vector<double>      &ids,
+                      std::string              &id_name,
+                      std::vector<std::string> &next_section)
+      {
+        const auto &names = id_field_names();
+        const auto  keep  = [&](const std::string    &name,
+                              const unsigned int    n_components,
+                              std::vector<double> &&values) {
+          const auto rank = std::find(names.begin(), names.end(), name);
+          if (!cells || rank == names.end())
+            return;
+          if (n_components != 1)
+            vtk.fail("cell field '" + name + "' has " +
+                     std::to_string(n_components) +
+                     " components; ids have one");
+          if (id_name.empty() ||
+              rank < std::find(names.begin(), names.end(), id_name))
+            {
+              id_name = name;
+              ids     = std::move(values);
+            }
+        };
+        next_section.clear();
+        while (!vtk.at_end())
+          {
+            auto              words = vtk.keyword_line("an attribute");
+            const std::string kind  = upper(words[0]);
+            if (kind == "CELL_DATA" || kind == "POINT_DATA")
+              {
+                next_section = words;
+                return;
+              }
+            if (kind == "SCALARS")
+              {
+                if (words.size() < 3)
+                  vtk.fail("SCALARS needs a name and a data type");
+                const unsigned int n_components =
+                  words.size() > 3 ? vtk.count(words[3], "component count") : 1;
+                if (n_components < 1 || n_components > 4)
+                  vtk.fail("SCALARS with " + words[3] + " components");
+                const auto table = vtk.keyword_line("LOOKUP_TABLE");
+                if (upper(table[0]) != "LOOKUP_TABLE")
+                  vtk.fail("expected LOOKUP_TABLE, found '" + table[0] + "'");
+                keep(words[1],
+                     n_components,
+                     vtk.values(n * n_components,
+                                words[2],
+                                "SCALARS " + words[1]));
+                vtk.skip_metadata();
+              }
+            else if (kind == "VECTORS" || kind == "NORMALS" ||
+                     kind == "TENSORS")
+              {
+                if (words.size() < 3)
+                  vtk.fail(kind + " needs a name and a data type");
+                vtk.values(n * (kind == "TENSORS" ? 9 : 3), words[2], kind);
+                vtk.skip_metadata();
+              }
+            else if (kind == "FIELD")
+              read_field(vtk, words, n, keep);
+            else
+              vtk.fail("attribute '" + words[0] +
+                       "' (knee_contact reads SCALARS, VECTORS, NORMALS, "
+                       "TENSORS and FIELD)");
+          }
+      }
+    } // namespace
+
+
+
+    Description<2>
+    read_vtk(const std::string &file)
+    {
+      LegacyFile  vtk(file);
+      std::string line;
+      if (!vtk.line(line) || line.rfind("# vtk DataFile Version", 0) != 0)
+        vtk.fail("not a legacy VTK file (no '# vtk DataFile Version' "
+                 "header)");
+      if (!vtk.line(line))
+        vtk.fail("the file ends where the title should be");
+      const std::string format = upper(trim(vtk.keyword_line("ASCII or "
+                                                             "BINARY")[0]));
+      if (format != "ASCII" && format != "BINARY")
+        vtk.fail("expected ASCII or BINARY, found '" + format + "'");
+      vtk.binary         = format == "BINARY";
+      const auto dataset = vtk.keyword_line("DATASET");
+      if (dataset.size() != 2 || upper(dataset[0]) != "DATASET" ||
+          upper(dataset[1]) != "UNSTRUCTURED_GRID")
+        vtk.fail("DATASET is not UNSTRUCTURED_GRID");
+
+      std::vector<double>      points, offsets, connectivity, types, ids;
+      std::string              id_name;
+      std::size_t              n_points = 0, n_cells = 0;
+      bool                     have_points = false, have_cells = false;
+      std::vector<std::string> words;
+      while (!vtk.at_end() || !words.empty())
+        {
+          if (words.empty())
+            words = vtk.keyword_line("a section");
+          const std::string kind = upper(words[0]);
+          if (kind == "POINTS")
+            {
+              if (words.size() != 3)
+                vtk.fail("POINTS needs a count and a data type");
+              n_points = vtk.count(words[1], "point count");
+              if (n_points > std::size_t(-1) / 3)
+                vtk.fail("point count " + words[1] + " is too large");
+              points      = vtk.values(3 * n_points, words[2], "POINTS");
+              have_points = true;
+              vtk.skip_metadata();
+              words.clear();
+            }
+          else if (kind == "CELLS")
+            {
+              if (words.size() != 3)
+                vtk.fail("CELLS needs two counts");
+              const std::size_t first  = vtk.count(words[1], "cell count");
+              const std::size_t second = vtk.count(words[2], "cell list size");
+              if (vtk.next_is("OFFSETS"))
+                {
+                  auto next = vtk.keyword_line("OFFSETS");
+                  // 5.1: OFFSETS (cells + 1 of them, from 0) and
+                  // CONNECTIVITY.
+                  if (next.size() != 2 || first == 0)
+                    vtk.fail("OFFSETS needs a data type and CELLS a count "
+                             "of at least 1");
+                  auto all_offsets = vtk.values(first, next[1], "OFFSETS");
+                  if (all_offsets[0] != 0)
+                    vtk.fail("OFFSETS do not start at 0");
+                  vtk.skip_metadata();
+                  next = vtk.keyword_line("CONNECTIVITY");
+                  if (upper(next[0]) != "CONNECTIVITY" || next.size() != 2)
+                    vtk.fail("expected CONNECTIVITY and a data type");
+                  connectivity = vtk.values(second, next[1], "CONNECTIVITY");
+                  vtk.skip_metadata();
+                  if (all_offsets.back() != double(second))
+                    vtk.fail("the last of the OFFSETS is not the "
+                             "CONNECTIVITY size " +
+                             std::to_string(second));
+                  n_cells = first - 1;
+                  offsets.assign(all_offsets.begin() + 1, all_offsets.end());
+                  words.clear();
+                }
+              else
+                {
+                  // 4.2 and earlier: each cell's vertex count, then its
+                  // vertices; the list is of type int.
+                  const auto list = vtk.values(second, "int", "CELLS");
+                  n_cells         = first;
+                  std::size_t k   = 0;
+                  for (std::size_t c = 0; c < n_cells; ++c)
+                    {
+                      if (k >= list.size())
+                        vtk.fail("CELLS says " + words[2] +
+                                 " numbers, the cells need more");
+                      const double n = list[k];
+                      if (n < 1 || n > 4 || n != std::floor(n))
+                        vtk.fail("cell " + std::to_string(c) + " has " +
+                                 std::to_string(n) + " vertices");
+                      if (k + 1 + std::size_t(n) > list.size())
+                        vtk.fail("CELLS says " + words[2] +
+                                 " numbers, the cells need more");
+                      connectivity.insert(connectivity.end(),
+                                          list.begin() + k + 1,
+                                          list.begin() + k + 1 +
+                                            std::size_t(n));
+                      k += 1 + std::size_t(n);
+                      offsets.push_back(double(connectivity.size()));
+                    }
+                  if (k != list.size())
+                    vtk.fail("CELLS says " + words[2] +
+                             " numbers, the cells have " + std::to_string(k));
+                  vtk.skip_metadata();
+                  words.clear();
+                }
+              have_cells = true;
+            }
+          else if (kind == "CELL_TYPES")
+            {
+              if (words.size() != 2 ||
+                  vtk.count(words[1], "cell type count") != n_cells ||
+                  !have_cells)
+                vtk.fail("CELL_TYPES count differs from CELLS");
+              types = vtk.values(n_cells, "int", "CELL_TYPES");
+              vtk.skip_metadata();
+              words.clear();
+            }
+          else if (kind == "FIELD")
+            {
+              // Data of the whole set (TIME, CYCLE): not mesh data.
+              read_field(vtk,
+                         words,
+                         std::size_t(-1),
+                         [](const std::string &,
+                            const unsigned int,
+                            std::vector<double> &&) {});
+              words.clear();
+            }
+          else if (kind == "CELL_DATA" || kind == "POINT_DATA")
+            {
+              const bool cells = kind == "CELL_DATA";
+              if (words.size() != 2)
+                vtk.fail(kind + " needs a count");
+              const std::size_t n = vtk.count(words[1], kind + " count");
+              if (n != (cells ? n_cells : n_points))
+                vtk.fail(kind + " count differs from " +
+                         (cells ? "CELLS" : "POINTS"));
+              read_attributes(vtk, n, cells, ids, id_name, words);
+            }
+          else
+            vtk.fail("section '" + words[0] +
+                     "' (knee_contact reads POINTS, CELLS, CELL_TYPES, "
+                     "CELL_DATA and POINT_DATA)");
+        }
+      if (!have_points || !have_cells || types.size() != n_cells)
+        vtk.fail("the file has no POINTS, CELLS and CELL_TYPES");
+      return unstructured_grid(points,
+                               offsets,
+                               connectivity,
+                               types,
+                               ids,
+                               id_name.empty() ? "MaterialID" : id_name,
+                               [&file](const std::string &what) {
+                                 // Checks of the whole grid: no one line.
+                                 throw std::runtime_error(input::cap(
+                                   "Mesh/File: '" + file + "': " + what));
+                               });
     }
   } // namespace mesh_readers
 } // namespace knee_contact

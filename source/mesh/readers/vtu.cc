@@ -319,12 +319,6 @@ namespace knee_contact
         throw std::runtime_error(
           input::cap("Mesh/File: '" + file + "': " + what));
       };
-      // A number read from a file as it would be written there.
-      const auto text_of = [](const double value) {
-        std::ostringstream stream;
-        stream << value;
-        return stream.str();
-      };
 
       // Raw appended data is not XML: cut it off before parsing.
       std::string appended;
@@ -419,72 +413,106 @@ namespace knee_contact
         fail("the last offset is not a connectivity length");
       const auto connectivity =
         array("Cells", "connectivity", std::size_t(n_connected), true);
-      const auto ids = array("CellData", "MaterialID", n_cells, false);
+      // The first cell field of id_field_names() the file has.
+      std::vector<double> ids;
+      std::string         id_name = "MaterialID";
+      for (const auto &name : id_field_names())
+        if (ids.empty())
+          {
+            ids = array("CellData", name, n_cells, false);
+            if (!ids.empty())
+              id_name = name;
+          }
 
-      Description<2> mesh;
-      for (std::size_t i = 0; i < n_points; ++i)
-        {
-          for (unsigned int d = 0; d < 3; ++d)
-            if (!std::isfinite(points[3 * i + d]))
-              fail("point " + std::to_string(i) +
-                   " has a coordinate that is not finite");
-          if (points[3 * i + 2] != 0)
-            fail("point " + std::to_string(i) +
-                 " has z != 0: knee_contact meshes lie in the x-y plane");
-          mesh.vertices.emplace_back(points[3 * i], points[3 * i + 1]);
-        }
-      double begin = 0;
-      for (std::size_t c = 0; c < n_cells; ++c)
-        {
-          const double                        end        = offsets[c];
-          const std::map<double, std::size_t> n_vertices = {{1, 1},
-                                                            {3, 2},
-                                                            {5, 3},
-                                                            {9, 4}};
-          if (types[c] != std::floor(types[c]) || end != std::floor(end))
-            fail("cell " + std::to_string(c) +
-                 ": a type or an offset that is not an integer");
-          if (n_vertices.count(types[c]) == 0)
-            fail("cell " + std::to_string(c) + " has VTK type " +
-                 text_of(types[c]) +
-                 ", not a vertex (1), line (3), triangle (5) or "
-                 "quadrilateral (9)");
-          if (end - begin != n_vertices.at(types[c]))
-            fail("cell " + std::to_string(c) + " of type " +
-                 std::to_string(int(types[c])) + " has " +
-                 text_of(end - begin) + " vertices");
-          std::vector<unsigned int> vertices;
-          for (auto k = std::size_t(begin); k < std::size_t(end); ++k)
-            {
-              const double v = connectivity[k];
-              if (v < 0 || v >= n_points || v != std::floor(v))
-                fail("cell " + std::to_string(c) + " refers to point " +
-                     text_of(v) + ", but there are " +
-                     std::to_string(n_points) + " points");
-              vertices.push_back(static_cast<unsigned int>(v));
-            }
-          begin = end;
-          if (std::set<unsigned int>(vertices.begin(), vertices.end()).size() !=
-              vertices.size())
-            fail("cell " + std::to_string(c) + " names a point twice");
-          const double id = ids.empty() ? 0 : ids[c];
-          if (id < 0 || id >= 255 || id != std::floor(id))
-            fail("MaterialID " + text_of(id) + " of cell " + std::to_string(c) +
-                 " is not in 0..254");
-          if (types[c] == 3)
-            add_boundary_line(mesh,
-                              vertices[0],
-                              vertices[1],
-                              static_cast<types::boundary_id>(id));
-          else if (types[c] != 1)
-            add_cell(mesh, vertices, static_cast<types::material_id>(id));
-        }
-      if (mesh.cells.empty())
-        fail("no triangles or quadrilaterals");
-      GridTools::delete_unused_vertices(mesh.vertices,
-                                        mesh.cells,
-                                        mesh.subcells);
-      return mesh;
+      return unstructured_grid(
+        points, offsets, connectivity, types, ids, id_name, fail);
     }
-  } // namespace mesh_readers
+
+
+
+    namespace internal
+    {
+      Description<2>
+      unstructured_grid(const std::vector<double> &points,
+                        const std::vector<double> &offsets,
+                        const std::vector<double> &connectivity,
+                        const std::vector<double> &types,
+                        const std::vector<double> &ids,
+                        const std::string         &id_name,
+                        const std::function<void(const std::string &)> &fail)
+      {
+        const std::size_t n_points = points.size() / 3;
+        const std::size_t n_cells  = types.size();
+        const auto        text_of  = [](const double value) {
+          std::ostringstream stream;
+          stream << value;
+          return stream.str();
+        };
+        Description<2> mesh;
+        for (std::size_t i = 0; i < n_points; ++i)
+          {
+            for (unsigned int d = 0; d < 3; ++d)
+              if (!std::isfinite(points[3 * i + d]))
+                fail("point " + std::to_string(i) +
+                     " has a coordinate that is not finite");
+            if (points[3 * i + 2] != 0)
+              fail("point " + std::to_string(i) +
+                   " has z != 0: knee_contact meshes lie in the x-y plane");
+            mesh.vertices.emplace_back(points[3 * i], points[3 * i + 1]);
+          }
+        double begin = 0;
+        for (std::size_t c = 0; c < n_cells; ++c)
+          {
+            const double                        end        = offsets[c];
+            const std::map<double, std::size_t> n_vertices = {{1, 1},
+                                                              {3, 2},
+                                                              {5, 3},
+                                                              {9, 4}};
+            if (types[c] != std::floor(types[c]) || end != std::floor(end))
+              fail("cell " + std::to_string(c) +
+                   ": a type or an offset that is not an integer");
+            if (n_vertices.count(types[c]) == 0)
+              fail("cell " + std::to_string(c) + " has VTK type " +
+                   text_of(types[c]) +
+                   ", not a vertex (1), line (3), triangle (5) or "
+                   "quadrilateral (9)");
+            if (end - begin != n_vertices.at(types[c]))
+              fail("cell " + std::to_string(c) + " of type " +
+                   std::to_string(int(types[c])) + " has " +
+                   text_of(end - begin) + " vertices");
+            std::vector<unsigned int> vertices;
+            for (auto k = std::size_t(begin); k < std::size_t(end); ++k)
+              {
+                const double v = connectivity[k];
+                if (v < 0 || v >= n_points || v != std::floor(v))
+                  fail("cell " + std::to_string(c) + " refers to point " +
+                       text_of(v) + ", but there are " +
+                       std::to_string(n_points) + " points");
+                vertices.push_back(static_cast<unsigned int>(v));
+              }
+            begin = end;
+            if (std::set<unsigned int>(vertices.begin(), vertices.end())
+                  .size() != vertices.size())
+              fail("cell " + std::to_string(c) + " names a point twice");
+            const double id = ids.empty() ? 0 : ids[c];
+            if (id < 0 || id >= 255 || id != std::floor(id))
+              fail(id_name + " " + text_of(id) + " of cell " +
+                   std::to_string(c) + " is not in 0..254");
+            if (types[c] == 3)
+              add_boundary_line(mesh,
+                                vertices[0],
+                                vertices[1],
+                                static_cast<types::boundary_id>(id));
+            else if (types[c] != 1)
+              add_cell(mesh, vertices, static_cast<types::material_id>(id));
+          }
+        if (mesh.cells.empty())
+          fail("no triangles or quadrilaterals");
+        GridTools::delete_unused_vertices(mesh.vertices,
+                                          mesh.cells,
+                                          mesh.subcells);
+        return mesh;
+      }
+    } // namespace internal
+  }   // namespace mesh_readers
 } // namespace knee_contact

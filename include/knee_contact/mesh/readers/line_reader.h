@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -207,6 +208,40 @@ namespace knee_contact
         line.boundary_id = boundary_id;
         mesh.subcells.boundary_lines.push_back(line);
       }
+
+      /**
+       * The names of the cell field that gives material ids (and boundary
+       * ids of line cells) in VTK files, in the order they are looked for:
+       * knee_contact's and deal.II's MaterialID, then what meshio writes for
+       * a Gmsh mesh (gmsh:physical), VTK's own readers of Exodus and Gmsh
+       * files (CellEntityIds) and meshio for Medit files (medit:ref).
+       */
+      inline const std::vector<std::string> &
+      id_field_names()
+      {
+        static const std::vector<std::string> names = {"MaterialID",
+                                                       "gmsh:physical",
+                                                       "CellEntityIds",
+                                                       "medit:ref"};
+        return names;
+      }
+
+      /**
+       * The 2D mesh of a VTK unstructured grid, read by the .vtu and .vtk
+       * readers: @p points (x, y, z each; z must be 0), per cell the end
+       * of its vertices in @p connectivity (@p offsets) and its VTK type
+       * (@p types: vertex 1, ignored; line 3, a boundary edge; triangle 5;
+       * quadrilateral 9), and the cell field @p ids (empty: all 0), named
+       * @p id_name in messages. @p fail throws.
+       */
+      Description<2>
+      unstructured_grid(const std::vector<double> &points,
+                        const std::vector<double> &offsets,
+                        const std::vector<double> &connectivity,
+                        const std::vector<double> &types,
+                        const std::vector<double> &ids,
+                        const std::string         &id_name,
+                        const std::function<void(const std::string &)> &fail);
     } // namespace internal
   }   // namespace mesh_readers
 } // namespace knee_contact
