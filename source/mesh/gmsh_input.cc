@@ -24,6 +24,28 @@ namespace knee_contact
       {
         return input::number(text).has_value();
       }
+
+
+
+      // Run gmsh (argument vector, no shell, time limit) on @p input to
+      // write @p msh; any failure, or an error in its log, is the run's
+      // one-line error.
+      void
+      run_gmsh(const std::vector<std::string> &command,
+               const std::string              &input,
+               const std::string              &msh,
+               const double                    time_limit)
+      {
+        const std::string log =
+          std::filesystem::path(msh).replace_extension(".log").string();
+        const ProgramResult result = run_program(command, log, time_limit);
+        if (result.exit_code != 0 || !std::ifstream(msh).good() ||
+            result.message.find("rror") != std::string::npos)
+          throw std::runtime_error(
+            "Mesh/File: " +
+            describe_failure(
+              result, "gmsh", input, "Mesh/Gmsh time limit", time_limit));
+      }
     } // namespace
 
 
@@ -184,15 +206,7 @@ namespace knee_contact
         "gmsh", "-3", "-format", "msh41", "-v", "2", "-nopopup"};
       command.insert(command.end(), extra.begin(), extra.end());
       command.insert(command.end(), {"-o", msh, geo});
-      const std::string log =
-        std::filesystem::path(msh).replace_extension(".log").string();
-      const ProgramResult result = run_program(command, log, time_limit);
-      if (result.exit_code != 0 || !std::ifstream(msh).good() ||
-          result.message.find("rror") != std::string::npos)
-        throw std::runtime_error(
-          "Mesh/File: " +
-          describe_failure(
-            result, "gmsh", geo, "Mesh/Gmsh time limit", time_limit));
+      run_gmsh(command, geo, msh, time_limit);
     }
 
 
@@ -219,25 +233,19 @@ namespace knee_contact
             const double       time_limit)
     {
       // -0: read the file and write it out again, no meshing.
-      const std::vector<std::string> command = {"gmsh",
-                                                "-0",
-                                                "-format",
-                                                "msh41",
-                                                "-v",
-                                                "2",
-                                                "-nopopup",
-                                                "-o",
-                                                msh,
-                                                binary_msh};
-      const std::string              log =
-        std::filesystem::path(msh).replace_extension(".log").string();
-      const ProgramResult result = run_program(command, log, time_limit);
-      if (result.exit_code != 0 || !std::ifstream(msh).good() ||
-          result.message.find("rror") != std::string::npos)
-        throw std::runtime_error(
-          "Mesh/File: " +
-          describe_failure(
-            result, "gmsh", binary_msh, "Mesh/Gmsh time limit", time_limit));
+      run_gmsh({"gmsh",
+                "-0",
+                "-format",
+                "msh41",
+                "-v",
+                "2",
+                "-nopopup",
+                "-o",
+                msh,
+                binary_msh},
+               binary_msh,
+               msh,
+               time_limit);
     }
   } // namespace gmsh_input
 } // namespace knee_contact

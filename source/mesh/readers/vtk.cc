@@ -104,6 +104,7 @@ namespace knee_contact
                     static_cast<unsigned char>(text[p + word.size()])));
         }
 
+        /** Skip white space; true at the end of the file. */
         bool
         at_end()
         {
@@ -242,13 +243,7 @@ namespace knee_contact
         std::string
         ascii_word()
         {
-          while (at < text.size() &&
-                 std::isspace(static_cast<unsigned char>(text[at])))
-            {
-              if (text[at] == '\n')
-                ++newlines;
-              ++at;
-            }
+          at_end();
           if (at < text.size())
             line_number = newlines + 1;
           const std::size_t start = at;
