@@ -167,8 +167,9 @@ namespace knee_contact
     ParameterHandler    prm;
     blank.add_parameters(prm, Counts());
     // deal.II's PRM listing has the defaults and documentation but not the
-    // formats, its Description listing the formats but not the defaults;
-    // its JSON listing has all three, written here as a scene file.
+    // formats, its Description listing the formats but not the defaults:
+    // the JSON listing (defaults, documentation) is walked and each entry
+    // given its format from the Description listing (formats()).
     std::ostringstream json;
     prm.print_parameters(json, ParameterHandler::JSON);
     out << "# Every parameter of a scene: its documentation, its format and "

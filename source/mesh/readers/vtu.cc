@@ -476,6 +476,12 @@ namespace knee_contact
                    text_of(types[c]) +
                    ", not a vertex (1), line (3), triangle (5) or "
                    "quadrilateral (9)");
+            // Offsets that climb past the connectivity and come back down
+            // would pass the count test below and read beyond it.
+            if (end > static_cast<double>(connectivity.size()))
+              fail("cell " + std::to_string(c) + ": offset " + text_of(end) +
+                   " is beyond the " + std::to_string(connectivity.size()) +
+                   " connectivity entries");
             if (end - begin != n_vertices.at(types[c]))
               fail("cell " + std::to_string(c) + " of type " +
                    std::to_string(int(types[c])) + " has " +
