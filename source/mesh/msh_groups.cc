@@ -1,5 +1,6 @@
 #include <knee_contact/core/input.h>
 #include <knee_contact/mesh/gmsh_input.h>
+#include <knee_contact/mesh/readers/line_reader.h>
 
 #include <fstream>
 #include <map>
@@ -20,16 +21,7 @@ namespace knee_contact
   {
     namespace
     {
-      std::vector<std::string>
-      words(const std::string &line)
-      {
-        std::vector<std::string> result;
-        std::istringstream       in(line);
-        std::string              word;
-        while (in >> word)
-          result.push_back(word);
-        return result;
-      }
+      using mesh_readers::internal::words;
 
       std::string
       join(const std::vector<std::string> &fields)

@@ -23,12 +23,7 @@ namespace knee_contact
             const std::string text = trim(line);
             if (text.empty() || text[0] == '#')
               continue;
-            std::vector<std::string> words;
-            std::stringstream        stream(text);
-            std::string              word;
-            while (stream >> word)
-              words.push_back(word);
-            return words;
+            return words(text);
           }
         lines.fail("the file ends where " + what + " should be");
       };

@@ -74,13 +74,9 @@ namespace knee_contact
           std::string text_line;
           while (line(text_line))
             {
-              std::vector<std::string> words;
-              std::stringstream        stream(text_line);
-              std::string              word;
-              while (stream >> word)
-                words.push_back(word);
-              if (!words.empty())
-                return words;
+              auto result = words(text_line);
+              if (!result.empty())
+                return result;
             }
           fail("the file ends where " + what + " should be");
         }

@@ -100,6 +100,17 @@ namespace knee_contact
         return text.substr(first, text.find_last_not_of(" \t") - first + 1);
       }
 
+      /** The white-space separated words of @p line. */
+      inline std::vector<std::string>
+      words(const std::string &line)
+      {
+        std::vector<std::string> result;
+        std::istringstream       stream(line);
+        for (std::string word; stream >> word;)
+          result.push_back(word);
+        return result;
+      }
+
       inline std::vector<std::string>
       fields(const std::string &line)
       {
