@@ -6,8 +6,11 @@
 #include <deal.II/fe/mapping_q1.h>
 #include <deal.II/numerics/vector_tools.h>
 
+#include <array>
 #include <cmath>
 #include <map>
+#include <set>
+#include <vector>
 
 namespace knee_contact
 {
@@ -132,6 +135,135 @@ namespace knee_contact
 
 
 
+  namespace
+  {
+    /**
+     * u.n = 0 on the sliding boundary @p ids of a 3D mesh with tetrahedra
+     * (linear elements: vertex dofs only). Written by hand because deal.II
+     * 9.4's compute_no_normal_flux_constraints() assumes that a cell at an
+     * edge or corner of the boundary has a face on each side of it (true
+     * of hexahedra): on tetrahedra a cell often touches an edge with one
+     * face, the normals of the two sides are then averaged and only their
+     * mean direction constrained (measured: a block sliding on three
+     * planes off by 20 %), and its normal vector of a triangle is computed
+     * as of a quadrilateral. Here the normals at a vertex are grouped into
+     * surfaces: faces of one boundary id whose normals are within 45
+     * degrees of the group's mean are one (smooth) surface, other ids and
+     * sharper angles are others; one surface constrains u.n = 0, two
+     * constrain u to their edge's direction, three or more fix u.
+     */
+    void
+    sliding_constraints_on_simplices(const DoFHandler<3> &dof_handler,
+                                     const std::set<types::boundary_id> &ids,
+                                     AffineConstraints<double> &constraints)
+    {
+      struct Surface
+      {
+        types::boundary_id id;
+        Tensor<1, 3>       sum; // of the unit normals
+      };
+      // Per vertex: its dofs and the surfaces of its sliding faces.
+      std::map<
+        unsigned int,
+        std::pair<std::array<types::global_dof_index, 3>, std::vector<Surface>>>
+        vertices;
+      for (const auto &cell : dof_handler.active_cell_iterators())
+        for (const auto f : cell->face_indices())
+          {
+            const auto face = cell->face(f);
+            if (!face->at_boundary() || ids.count(face->boundary_id()) == 0)
+              continue;
+            // The plane of a triangle; of a quadrilateral the plane of its
+            // diagonals (flat faces of these meshes).
+            Tensor<1, 3> normal =
+              face->n_vertices() == 3
+                ? cross_product_3d(face->vertex(1) - face->vertex(0),
+                                   face->vertex(2) - face->vertex(0))
+                : cross_product_3d(face->vertex(3) - face->vertex(0),
+                                   face->vertex(2) - face->vertex(1));
+            normal /= normal.norm();
+            if (normal * (face->center() - cell->center()) < 0)
+              normal *= -1;
+            for (const auto v : face->vertex_indices())
+              {
+                auto &[dofs, surfaces] = vertices[face->vertex_index(v)];
+                for (unsigned int d = 0; d < 3; ++d)
+                  dofs[d] = face->vertex_dof_index(v, d);
+                bool found = false;
+                for (auto &surface : surfaces)
+                  if (surface.id == face->boundary_id() &&
+                      normal * surface.sum >=
+                        std::cos(numbers::PI / 4) * surface.sum.norm())
+                    {
+                      surface.sum += normal;
+                      found = true;
+                      break;
+                    }
+                if (!found)
+                  surfaces.push_back({face->boundary_id(), normal});
+              }
+          }
+      for (const auto &[vertex, dofs_and_surfaces] : vertices)
+        {
+          const auto &[dofs, surfaces] = dofs_and_surfaces;
+          // An orthonormal basis of the surfaces' normals.
+          std::vector<Tensor<1, 3>> basis;
+          for (const auto &surface : surfaces)
+            {
+              Tensor<1, 3> n = surface.sum / surface.sum.norm();
+              for (const auto &b : basis)
+                n -= (n * b) * b;
+              if (n.norm() > 1e-6)
+                basis.push_back(n / n.norm());
+            }
+          const auto largest = [](const Tensor<1, 3> &t) {
+            unsigned int d = 0;
+            for (unsigned int e = 1; e < 3; ++e)
+              if (std::abs(t[e]) > std::abs(t[d]))
+                d = e;
+            return d;
+          };
+          if (basis.size() == 1)
+            {
+              // n . u = 0: the component of the largest |n_d| follows.
+              const Tensor<1, 3> &n = basis[0];
+              const unsigned int  d = largest(n);
+              constraints.add_line(dofs[d]);
+              for (unsigned int e = 0; e < 3; ++e)
+                if (e != d && n[e] != 0)
+                  constraints.add_entry(dofs[d], dofs[e], -n[e] / n[d]);
+            }
+          else if (basis.size() == 2)
+            {
+              // u along the edge t: the other components follow u_d.
+              const Tensor<1, 3> t = cross_product_3d(basis[0], basis[1]);
+              const unsigned int d = largest(t);
+              for (unsigned int e = 0; e < 3; ++e)
+                if (e != d)
+                  {
+                    constraints.add_line(dofs[e]);
+                    if (t[e] != 0)
+                      constraints.add_entry(dofs[e], dofs[d], t[e] / t[d]);
+                  }
+            }
+          else
+            for (unsigned int d = 0; d < 3; ++d)
+              constraints.add_line(dofs[d]);
+        }
+    }
+
+    template <int dim>
+    void
+    sliding_constraints_on_simplices(const DoFHandler<dim> &,
+                                     const std::set<types::boundary_id> &,
+                                     AffineConstraints<double> &)
+    {
+      Assert(false, ExcInternalError());
+    }
+  } // namespace
+
+
+
   template <int dim>
   void
   BoundaryConditions<dim>::make_constraints(
@@ -163,12 +295,18 @@ namespace knee_contact
     if (!sliding.empty())
       {
         AffineConstraints<double> sliding_constraints;
-        VectorTools::compute_no_normal_flux_constraints(dof_handler,
-                                                        0,
-                                                        sliding,
-                                                        sliding_constraints,
-                                                        elements::mapping(
-                                                          dof_handler));
+        if (dim == 3 && !dof_handler.get_triangulation()
+                           .all_reference_cells_are_hyper_cube())
+          sliding_constraints_on_simplices(dof_handler,
+                                           sliding,
+                                           sliding_constraints);
+        else
+          VectorTools::compute_no_normal_flux_constraints(dof_handler,
+                                                          0,
+                                                          sliding,
+                                                          sliding_constraints,
+                                                          elements::mapping(
+                                                            dof_handler));
         sliding_constraints.close();
         constraints.merge(
           sliding_constraints,
