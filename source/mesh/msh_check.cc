@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -105,7 +106,11 @@ namespace knee_contact
           if (token.empty() || token.size() > 18 ||
               token.find_first_not_of("-0123456789") != std::string::npos)
             fail(what + " '" + token + "' is not an integer");
-          return std::stoll(token);
+          const long long value = std::stoll(token);
+          // deal.II's reader keeps tags in int.
+          if (std::abs(value) > std::numeric_limits<int>::max())
+            fail(what + " " + token + " is out of range");
+          return value;
         }
 
         // A node tag of $Nodes, which must not repeat.
@@ -264,7 +269,8 @@ namespace knee_contact
                                "element count");
                 for (unsigned long long i = 0; i < n; ++i)
                   {
-                    t                    = reader.expect(4, 64, "an element");
+                    t = reader.expect(4, 64, "an element");
+                    reader.tag(t[0], "element tag");
                     const long long type = reader.tag(t[1], "element type");
                     const auto [n_v, element_dim] =
                       nodes_and_dimension(type, reader);
@@ -371,6 +377,8 @@ namespace knee_contact
             else if (t[0] == "$Nodes")
               {
                 t = reader.expect(4, 4, "'numEntityBlocks numNodes ...'");
+                reader.tag(t[2], "smallest node tag");
+                reader.tag(t[3], "largest node tag");
                 const auto         n_blocks = reader.count(t[0], "block count");
                 const auto         n_total  = reader.count(t[1], "node count");
                 unsigned long long n_read   = 0;
@@ -404,6 +412,8 @@ namespace knee_contact
                 if (!have_nodes)
                   reader.fail("$Elements before $Nodes");
                 t = reader.expect(4, 4, "'numEntityBlocks numElements ...'");
+                reader.tag(t[2], "smallest element tag");
+                reader.tag(t[3], "largest element tag");
                 const auto n_blocks = reader.count(t[0], "block count");
                 for (unsigned long long b = 0; b < n_blocks; ++b)
                   {
@@ -428,6 +438,7 @@ namespace knee_contact
                         t = reader.expect(1 + n_v,
                                           1 + n_v,
                                           "an element 'tag nodes...'");
+                        reader.tag(t[0], "element tag");
                         reader.check_element_nodes(nodes, t, 1);
                       }
                   }
