@@ -224,7 +224,9 @@ namespace knee_contact
     parse_scene(prm, scene_file, false);
 
     mesh_input.check_parameters(scene_file);
-    materials.check_parameters();
+    materials.check_parameters(materials.constants_from_mesh
+                                 ? mesh_input.deck_materials()
+                                 : decltype(mesh_input.deck_materials())());
     boundary_conditions.check_parameters();
     contact_interfaces.check_parameters();
     active_set_solver.check_parameters(materials.max_youngs_modulus());

@@ -120,11 +120,34 @@ namespace knee_contact
     const double time_limit = mesh_input.gmsh_time_limit;
     const auto   extension  = std::filesystem::path(file).extension();
     // Anything else is 2D; a missing file is reported by MeshInput.
-    if (!from_file || (extension != ".msh" && extension != ".geo") ||
+    if (!from_file ||
+        (extension != ".msh" && extension != ".geo" && extension != ".inp") ||
         !std::filesystem::is_regular_file(file) || !std::ifstream(file).good())
       return 2;
+    if (extension == ".inp")
+      return mesh_readers::abaqus_dimension(file);
     kept_msh = checked_msh(file, arguments, time_limit);
     return kept_msh->dim;
+  }
+
+
+
+  template <int dim>
+  std::map<types::material_id, mesh_readers::DeckMaterial>
+  MeshInput<dim>::deck_materials() const
+  {
+    AssertThrow(source == Source::file &&
+                  std::filesystem::path(file).extension() == ".inp",
+                ExcMessage("Materials/Elastic constants: 'mesh file' takes "
+                           "E and nu from an Abaqus deck (.inp), and "
+                           "Mesh/File is " +
+                           (source == Source::file ? "'" + file + "'"
+                                                   : std::string("not set"))));
+    read_deck = std::make_unique<mesh_readers::Description<dim>>(
+      mesh_readers::read_abaqus<dim>(file,
+                                     abaqus_element_sets,
+                                     abaqus_boundary_sets));
+    return read_deck->deck_materials;
   }
 
 
@@ -197,18 +220,21 @@ namespace knee_contact
     mesh_readers::Description<dim> mesh;
     if (extension == ".msh" || extension == ".geo")
       mesh = read_gmsh(level);
+    else if (extension == ".inp")
+      {
+        if (read_deck == nullptr)
+          deck_materials();
+        mesh = std::move(*read_deck);
+        read_deck.reset();
+      }
     else if constexpr (dim == 3)
       {
-        // scene_dimension() gives 3 for Gmsh files only.
+        // scene_dimension() gives 3 for Gmsh and Abaqus files only.
         AssertThrow(false, ExcInternalError());
       }
     else
       {
-        if (extension == ".inp")
-          mesh = mesh_readers::read_abaqus(file,
-                                           abaqus_element_sets,
-                                           abaqus_boundary_sets);
-        else if (extension == ".vtk")
+        if (extension == ".vtk")
           mesh = mesh_readers::read_vtk(file);
         else if (extension == ".vtu")
           mesh = mesh_readers::read_vtu(file);

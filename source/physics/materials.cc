@@ -66,6 +66,15 @@ namespace knee_contact
                          {{"strain", true}, {"stress", false}},
                          "2D model: plane strain (e_zz = 0, the default) or "
                          "plane stress (tau_zz = 0); unused in 3D.");
+    input::add_selection(
+      prm,
+      "Elastic constants",
+      constants_from_mesh,
+      {{"scene", false}, {"mesh file", true}},
+      "scene: each material's Young's modulus and Poisson's ratio as given "
+      "below; mesh file: from the Abaqus deck of Mesh/File (the *Material "
+      "of the *Solid Section of the material's cells, its isotropic "
+      "*Elastic line); a material that gives them too must agree to 1e-9.");
     // Bound by reference: the vector is sized once, before binding.
     entries.clear();
     entries.resize(n_subsections);
@@ -89,6 +98,14 @@ namespace knee_contact
                           entry.poissons_ratio,
                           "Poisson's ratio nu, in (-1, 0.5).",
                           Patterns::Double());
+        // add_action runs once now with the default (deal.II 9.4), then
+        // for the scene's value: the flags are reset below.
+        prm.add_action("Young's modulus", [&entry](const std::string &) {
+          entry.youngs_modulus_given = true;
+        });
+        prm.add_action("Poisson's ratio", [&entry](const std::string &) {
+          entry.poissons_ratio_given = true;
+        });
         input::add_selection(
           prm,
           "Volumetric integration",
@@ -105,6 +122,7 @@ namespace knee_contact
                           "F_y; F_z) in x, y, z.",
                           input::expression_pattern(3));
         prm.leave_subsection();
+        entry.youngs_modulus_given = entry.poissons_ratio_given = false;
       }
     prm.leave_subsection();
   }
@@ -113,7 +131,57 @@ namespace knee_contact
 
   template <int dim>
   void
-  Materials<dim>::check_parameters()
+  Materials<dim>::take_deck_constants(
+    const Entry             &entry,
+    const std::string       &section,
+    const types::material_id id,
+    const std::map<types::material_id, mesh_readers::DeckMaterial>
+                  &deck_materials,
+    Material<dim> &material)
+  {
+    const auto deck = deck_materials.find(id);
+    AssertThrow(deck != deck_materials.end(),
+                ExcMessage("Materials/" + section +
+                           ": Elastic constants = mesh file, and no cell of "
+                           "the deck has material id " +
+                           std::to_string(id)));
+    AssertThrow(deck->second.problem.empty(),
+                ExcMessage("Materials/" + section +
+                           ": Elastic constants = mesh file, and the deck "
+                           "gives material id " +
+                           std::to_string(id) +
+                           " no constants: " + deck->second.problem));
+    const auto agree = [&](const std::string &name,
+                           const bool         given,
+                           const double       scene,
+                           const double       from_deck) {
+      std::ostringstream text;
+      text << std::setprecision(17) << "Materials/" << section << "/" << name
+           << ": " << scene << " in the scene, " << from_deck
+           << " in the deck's material '" << deck->second.name
+           << "' (Elastic constants = mesh file: give it once, or the same)";
+      AssertThrow(!given ||
+                    std::abs(scene - from_deck) <= 1e-9 * std::abs(from_deck),
+                  ExcMessage(text.str()));
+      return from_deck;
+    };
+    material.youngs_modulus = agree("Young's modulus",
+                                    entry.youngs_modulus_given,
+                                    entry.youngs_modulus,
+                                    deck->second.youngs_modulus);
+    material.poissons_ratio = agree("Poisson's ratio",
+                                    entry.poissons_ratio_given,
+                                    entry.poissons_ratio,
+                                    deck->second.poissons_ratio);
+  }
+
+
+
+  template <int dim>
+  void
+  Materials<dim>::check_parameters(
+    const std::map<types::material_id, mesh_readers::DeckMaterial>
+      &deck_materials)
   {
     for (unsigned int m = 0; m < entries.size(); ++m)
       {
@@ -132,8 +200,10 @@ namespace knee_contact
                       ExcMessage("Materials/" + section + "/Name: '" +
                                  material.name +
                                  "' is the name of another material too"));
-        material.youngs_modulus     = entry.youngs_modulus;
-        material.poissons_ratio     = entry.poissons_ratio;
+        material.youngs_modulus = entry.youngs_modulus;
+        material.poissons_ratio = entry.poissons_ratio;
+        if (constants_from_mesh)
+          take_deck_constants(entry, section, id, deck_materials, material);
         material.plane_strain       = plane_strain;
         material.reduced_volumetric = entry.reduced_volumetric;
         const double       E        = material.youngs_modulus;

@@ -3,7 +3,7 @@
 
 The contact patch mesh of tests/meshes/patch_stack.geo (a mixed mesh) is
 written in every format mesh_formats.py writes (.msh ASCII and binary, our
-flat and multi-part and Gmsh's .inp,
+flat and multi-part and Gmsh's .inp, the 3D two-part deck of abaqus_3d.py,
 .vtk in the ASCII and binary 4.2 layout and meshio's ASCII and binary 5.1
 layout, .ucd, .vtu in five encodings); each file is then damaged with a fixed
 seed: cut at several offsets, bytes overwritten by random bytes, a digit
@@ -28,6 +28,7 @@ sys.dont_write_bytecode = True
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)),
                                 "..", "drivers"))
+import abaqus_3d  # noqa: E402
 import fuzz  # noqa: E402
 import mesh_formats  # noqa: E402
 
@@ -112,6 +113,16 @@ def main():
             files[suffix] = os.path.join(folder, "mesh" + suffix)
             mesh_formats.write_vtu(files[suffix], nodes, cells, lines,
                                    encoding)
+        # The 3D two-part deck (hexahedra, skew rotation, *Elastic) with
+        # its own scene.
+        deck_3d = os.path.join(folder, "mesh_3d_parts.inp")
+        abaqus_3d.write_deck(deck_3d, False)
+        scene_3d = abaqus_3d.two_instance_scene(
+            "@WORK@/mesh.inp", False).replace("@FOLDER@", "@WORK@/out")
+        for _ in range(per_file):
+            damaged, what = damage(open(deck_3d, "rb").read(), rng)
+            cases.append(("mesh_3d_parts.inp: %s" % what, scene_3d,
+                          ("mesh.inp", damaged)))
         for suffix, path in sorted(files.items()):
             data = open(path, "rb").read()
             element_sets, boundary_sets = SETS.get(suffix, ("", ""))

@@ -10,6 +10,7 @@
 
 #include <array>
 #include <map>
+#include <memory>
 #include <set>
 #include <string>
 #include <tuple>
@@ -41,8 +42,8 @@ namespace knee_contact
 
   /**
    * One Triangulation<dim> holding all bodies: read from a mesh file (Gmsh
-   * .msh or .geo, which the gmsh program meshes first; in 2D also Abaqus
-   * .inp, VTK .vtk/.vtu, UCD) or generated from rectangles (2D). Physical
+   * .msh or .geo, which the gmsh program meshes first; Abaqus .inp; in 2D
+   * also VTK .vtk/.vtu, UCD) or generated from rectangles (2D). Physical
    * surfaces (2D) or volumes (3D) are material ids, physical curves (2D) or
    * surfaces (3D) boundary ids. Bodies that share vertices are bonded;
    * bodies in contact must have distinct (possibly coincident) vertices on
@@ -98,7 +99,19 @@ namespace knee_contact
     bool
     remeshes(const Triangulation<dim> &triangulation) const;
 
+    /**
+     * The elastic constants the Abaqus deck Mesh/File gives each material
+     * id (*Solid Section, *Material, *Elastic), for Materials/Elastic
+     * constants = mesh file; refused for other files. The deck is read
+     * once: create() takes the mesh read here.
+     */
+    std::map<types::material_id, mesh_readers::DeckMaterial>
+    deck_materials() const;
+
   private:
+    /** The Abaqus deck deck_materials() read, until create() takes it. */
+    mutable std::unique_ptr<mesh_readers::Description<dim>> read_deck;
+
     struct Rectangle
     {
       Point<2>                          lower, upper;

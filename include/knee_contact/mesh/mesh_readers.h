@@ -21,8 +21,22 @@ namespace knee_contact
   namespace mesh_readers
   {
     /**
+     * The linear elastic constants an Abaqus deck gives the cells of one
+     * material id (*Solid Section, MATERIAL= and that *Material's
+     * *Elastic), or why it gives none.
+     */
+    struct DeckMaterial
+    {
+      std::string name; // of the *Material
+      double      youngs_modulus = 0;
+      double      poissons_ratio = 0;
+      std::string problem; // empty if the constants are given
+    };
+
+    /**
      * A coarse mesh as deal.II's create_triangulation takes it. The readers
-     * of this file read 2D meshes; 3D meshes come from Gmsh (MeshInput).
+     * of this file read 2D meshes, the Abaqus reader 3D ones too; other 3D
+     * meshes come from Gmsh (MeshInput).
      */
     template <int dim = 2>
     struct Description
@@ -30,12 +44,22 @@ namespace knee_contact
       std::vector<Point<dim>>    vertices;
       std::vector<CellData<dim>> cells;
       SubCellData                subcells;
+      /** Abaqus decks: by material id. */
+      std::map<types::material_id, DeckMaterial> deck_materials;
     };
 
     /**
-     * Read an Abaqus input deck (.inp): *Node, *Element (CPS3, CPE3,
-     * CPS4, CPE4 and their R/H/I variants), *Elset, *Nset (with or without
-     * GENERATE), *Surface (TYPE=ELEMENT with S1-S4 faces, or TYPE=NODE),
+     * 3 if the Abaqus deck @p file (with the decks it includes) has 3D
+     * solid elements (C3D...), else 2.
+     */
+    unsigned int
+    abaqus_dimension(const std::string &file);
+
+    /**
+     * Read an Abaqus input deck (.inp): *Node, *Element (2D: CPS3, CPE3,
+     * CPS4, CPE4; 3D: C3D4, C3D8; with their R/H/I variants), *Elset,
+     * *Nset (with or without GENERATE), *Surface (TYPE=ELEMENT with faces
+     * S1-S4, S1-S6 of hexahedra, or TYPE=NODE),
      * flat or as Abaqus/CAE writes it: *Part, *Assembly, *Instance (moved
      * by its translation and rotation lines), sets and surfaces of the
      * assembly over instances (INSTANCE= or INSTANCE.NAME), *Include,
@@ -44,13 +68,17 @@ namespace knee_contact
      * refused by name.
      * @p element_sets gives each element set its material id (empty: the
      * element sets of the *Solid Section lines in file order get 1, 2, ...);
-     * @p boundary_sets gives a surface or node set its boundary id (a
-     * boundary edge whose two nodes are in a node set belongs to it).
+     * @p boundary_sets gives a surface, node set or set of facet elements
+     * (2D: lines, 3D: CPS/CPE/SFM3D triangles and quadrilaterals) its
+     * boundary id (a boundary face whose nodes are all in a node set
+     * belongs to it). Each material id's *Material constants are returned
+     * in Description::deck_materials.
      * Written by hand: deal.II 9.4's read_abaqus reads quadrilaterals only,
      * takes ids only from names of the form EB<n>, Material-<n>, SS<n>,
      * and trusts numbering and counts.
      */
-    Description<2>
+    template <int dim>
+    Description<dim>
     read_abaqus(const std::string                         &file,
                 const std::map<std::string, unsigned int> &element_sets,
                 const std::map<std::string, unsigned int> &boundary_sets);

@@ -1,6 +1,8 @@
 #ifndef knee_contact_materials_h
 #define knee_contact_materials_h
 
+#include <knee_contact/mesh/mesh_readers.h>
+
 #include <deal.II/base/function_parser.h>
 #include <deal.II/base/parameter_handler.h>
 #include <deal.II/base/symmetric_tensor.h>
@@ -81,10 +83,18 @@ namespace knee_contact
     /**
      * After parsing: the table from the entries, with the checks the
      * patterns cannot make (ids and names unique, E and nu in range, the
-     * contrast of the moduli, the body forces' expressions).
+     * contrast of the moduli, the body forces' expressions). With Elastic
+     * constants = mesh file, E and nu of each material come from
+     * @p deck_materials (by material id); a material that also gives them
+     * must agree.
      */
     void
-    check_parameters();
+    check_parameters(
+      const std::map<types::material_id, mesh_readers::DeckMaterial>
+        &deck_materials = {});
+
+    /** Elastic constants = mesh file: E and nu come from the Abaqus deck. */
+    bool constants_from_mesh = false;
 
     /** 'Number of materials' as the scene gives it. */
     unsigned int n_materials = 1;
@@ -130,13 +140,28 @@ namespace knee_contact
     {
       unsigned int material_id = 1;
       std::string  name;
-      double       youngs_modulus     = 1e9;
-      double       poissons_ratio     = 0.3;
-      bool         reduced_volumetric = false;
-      std::string  body_force         = dim == 2 ? "0; 0" : "0; 0; 0";
+      double       youngs_modulus = 1e9;
+      double       poissons_ratio = 0.3;
+      // Whether the scene file sets them (else the defaults above).
+      bool        youngs_modulus_given = false, poissons_ratio_given = false;
+      bool        reduced_volumetric = false;
+      std::string body_force         = dim == 2 ? "0; 0" : "0; 0; 0";
     };
     std::vector<Entry> entries;
-    bool               plane_strain = true;
+
+    /**
+     * E and nu of material id @p id (Materials/@p section) from the deck,
+     * refused if the deck gives none or the scene gives others.
+     */
+    void
+    take_deck_constants(
+      const Entry             &entry,
+      const std::string       &section,
+      const types::material_id id,
+      const std::map<types::material_id, mesh_readers::DeckMaterial>
+                    &deck_materials,
+      Material<dim> &material);
+    bool plane_strain = true;
 
     std::map<types::material_id, Material<dim>> materials;
   };

@@ -95,53 +95,194 @@ namespace knee_contact
 
       /**
        * A mesh as the deck defines it: a *Part, or the model as a whole
-       * (the flat deck, and every instance copied into it).
+       * (the flat deck, and every instance copied into it). Nodes keep
+       * three coordinates (a 2D deck's z must be 0).
        */
       struct Model
       {
-        std::map<long long, Point<2>>               nodes;
+        std::map<long long, Point<3>>               nodes;
         std::map<long long, std::vector<long long>> elements;
-        // Two-node line elements (trusses, beams): Gmsh's .inp export
-        // writes the physical curves as these; a set of them names boundary
-        // edges.
-        std::map<long long, std::pair<long long, long long>> line_elements;
-        std::map<std::string, std::set<long long>>           elsets, nsets;
+        // Elements of one dimension less than the cells (2D: two-node
+        // lines, trusses and beams; 3D: triangles and quadrilaterals of
+        // plane or surface type), node numbers sorted: Gmsh's .inp export
+        // writes the physical curves (2D) and surfaces (3D) as these; a set
+        // of them names boundary faces.
+        std::map<long long, std::vector<long long>> facet_elements;
+        std::map<std::string, std::set<long long>>  elsets, nsets;
         // Name -> (element number or element set, face).
         std::map<std::string, std::vector<std::pair<std::string, unsigned int>>>
                               surfaces;
         std::set<std::string> node_surfaces; // TYPE=NODE: node sets
-        // The element sets of *Solid Section lines and their material ids
-        // (1, 2, ... in file order).
-        std::vector<std::pair<std::string, unsigned int>> sections;
+        // The element sets of *Solid Section lines, their material ids
+        // (1, 2, ... in file order) and the *Material they name.
+        struct Section
+        {
+          std::string  elset;
+          unsigned int id;
+          std::string  material;
+        };
+        std::vector<Section> sections;
+      };
+
+      /**
+       * A *Material's linear elastic constants, or why it has none that
+       * knee_contact can take (only asked for when the scene takes the
+       * constants from the deck).
+       */
+      struct MaterialBlock
+      {
+        bool        elastic        = false;
+        double      youngs_modulus = 0, poissons_ratio = 0;
+        std::string problem;
       };
 
       /**
        * A *Instance: a copy of a part moved as its data lines say: a
        * translation, then a rotation about the axis from a to b by an angle
-       * in degrees (Abaqus applies them in this order); in 2D the axis must
-       * be parallel to z.
+       * in degrees, right-handed about a->b (Abaqus applies them in this
+       * order); in 2D the axis must be parallel to z.
        */
       struct Placement
       {
-        Tensor<1, 2> translation;
-        Point<2>     centre;
+        Tensor<1, 3> translation;
+        Point<3>     centre;
+        Tensor<1, 3> axis; // unit vector
         double       angle = 0;
 
-        Point<2>
-        operator()(const Point<2> &p) const
+        Point<3>
+        operator()(const Point<3> &p) const
         {
-          const Point<2> moved = p + translation;
-          const double   c = std::cos(angle), s = std::sin(angle);
-          const auto     d = moved - centre;
-          return centre +
-                 Tensor<1, 2>({c * d[0] - s * d[1], s * d[0] + c * d[1]});
+          // Rodrigues' rotation formula.
+          const Tensor<1, 3> d = p + translation - centre;
+          const double       c = std::cos(angle), s = std::sin(angle);
+          return centre + c * d + s * cross_product_3d(axis, d) +
+                 (1 - c) * (axis * d) * axis;
         }
       };
+
+      /**
+       * The nodes of face S(k+1) of an element with nodes @p nodes in
+       * Abaqus' numbering, round the face: 2D, the element's nodes k and
+       * k+1; C3D4 and C3D8 as Abaqus' element library lists their faces.
+       */
+      template <int dim>
+      std::vector<long long>
+      face_nodes(const std::vector<long long> &nodes, const unsigned int k)
+      {
+        if (dim == 2)
+          return {nodes[k], nodes[(k + 1) % nodes.size()]};
+        static const std::vector<std::vector<unsigned int>> tet = {{0, 1, 2},
+                                                                   {0, 3, 1},
+                                                                   {1, 3, 2},
+                                                                   {2, 3, 0}};
+        static const std::vector<std::vector<unsigned int>> hex = {
+          {0, 1, 2, 3},
+          {4, 7, 6, 5},
+          {0, 4, 5, 1},
+          {1, 5, 6, 2},
+          {2, 6, 7, 3},
+          {3, 7, 4, 0}};
+        std::vector<long long> result;
+        for (const unsigned int i : (nodes.size() == 4 ? tet : hex)[k])
+          result.push_back(nodes[i]);
+        return result;
+      }
+
+      /**
+       * The number of nodes of Abaqus element @p type if it is a linear
+       * element of cell dimension @p d in a mesh of dimension @p dim, else
+       * 0: lines (trusses, beams), plane triangles and quadrilaterals
+       * (CPS, CPE with R, H, I; in 3D also the surface elements SFM3D),
+       * tetrahedra and hexahedra (C3D4, C3D8 with R, H, I).
+       */
+      unsigned int
+      element_nodes(const std::string &type, const int d, const int dim)
+      {
+        const auto variant = [&](const std::string &base) {
+          return type.rfind(base, 0) == 0 &&
+                 type.find_first_not_of("RHI", base.size()) ==
+                   std::string::npos;
+        };
+        if (d == 1)
+          return variant("T2D2") || variant("T3D2") || variant("B21") ||
+                     variant("B31")
+                   ? 2
+                   : 0;
+        if (d == 2)
+          return variant("CPS3") || variant("CPE3") ||
+                     (dim == 3 && variant("SFM3D3"))
+                   ? 3
+                 : variant("CPS4") || variant("CPE4") ||
+                     (dim == 3 && variant("SFM3D4"))
+                   ? 4
+                   : 0;
+        return variant("C3D4") ? 4 : variant("C3D8") ? 8 : 0;
+      }
+
+      /**
+       * The file of an *Include line: its INPUT= as written (a path keeps
+       * its case).
+       */
+      std::string
+      include_input(const std::vector<std::string> &keyword_fields,
+                    const Deck                     &deck)
+      {
+        for (std::size_t i = 1; i < keyword_fields.size(); ++i)
+          {
+            const auto equal = keyword_fields[i].find('=');
+            if (equal != std::string::npos &&
+                upper(trim(keyword_fields[i].substr(0, equal))) == "INPUT" &&
+                !trim(keyword_fields[i].substr(equal + 1)).empty())
+              return trim(keyword_fields[i].substr(equal + 1));
+          }
+        deck.fail("*Include without INPUT=");
+      }
+
+      std::vector<long long>
+      sorted(std::vector<long long> nodes)
+      {
+        std::sort(nodes.begin(), nodes.end());
+        return nodes;
+      }
     } // namespace
 
 
 
-    Description<2>
+    unsigned int
+    abaqus_dimension(const std::string &file)
+    {
+      Deck        deck(file);
+      std::string line;
+      bool        solid = false;
+      while (deck.next(line))
+        {
+          std::string text = trim(line);
+          if (text.empty() || text[0] != '*' || text.rfind("**", 0) == 0)
+            continue;
+          std::string more;
+          while (text.back() == ',' && deck.next(more))
+            text += trim(more);
+          const auto        keyword_fields = fields(text);
+          const std::string keyword        = upper(keyword_fields[0]);
+          if (keyword == "*INCLUDE")
+            {
+              deck.include(include_input(keyword_fields, deck));
+            }
+          else if (keyword == "*ELEMENT")
+            {
+              const std::string type = option(keyword_fields, "TYPE");
+              // Quadratic ones too: the 3D reader names what it refuses.
+              solid |= type.rfind("C3D", 0) == 0;
+            }
+        }
+      // Plane elements beside solid ones are boundary faces.
+      return solid ? 3 : 2;
+    }
+
+
+
+    template <int dim>
+    Description<dim>
     read_abaqus(const std::string                         &file,
                 const std::map<std::string, unsigned int> &element_sets,
                 const std::map<std::string, unsigned int> &boundary_sets)
@@ -149,18 +290,20 @@ namespace knee_contact
       Deck deck(file);
       // The whole model: the flat deck's mesh and every instance's copy,
       // numbered apart; the sets of an instance are named INSTANCE.SET.
-      Model                        model;
-      std::map<std::string, Model> parts;
-      std::set<std::string>        instance_names;
-      Model                       *scope       = &model; // where definitions go
-      bool                         in_assembly = false;
-      unsigned int                 n_sections  = 0;
-      long long                    next_node   = 0;      // free numbers of
-      long long                    next_element     = 0; // the model
-      const auto                   fail_if_too_many = [&](const Model &m) {
+      Model                                model;
+      std::map<std::string, Model>         parts;
+      std::set<std::string>                instance_names;
+      std::map<std::string, MaterialBlock> materials;
+      MaterialBlock *open_material    = nullptr; // in a *Material
+      Model         *scope            = &model;  // where definitions go
+      bool           in_assembly      = false;
+      unsigned int   n_sections       = 0;
+      long long      next_node        = 0; // free numbers of
+      long long      next_element     = 0; // the model
+      const auto     fail_if_too_many = [&](const Model &m) {
         // At most one number per byte of the files: counts beyond that are
         // not a mesh but an attack on memory.
-        if (m.nodes.size() + m.elements.size() + m.line_elements.size() >
+        if (m.nodes.size() + m.elements.size() + m.facet_elements.size() >
             deck.size)
           deck.fail("more nodes and elements than the deck can hold");
       };
@@ -171,6 +314,7 @@ namespace knee_contact
       std::string  set_instance; // INSTANCE= of an assembly-level set
       bool         generate        = false;
       unsigned int n_element_nodes = 0;
+      bool         facets          = false; // *Element of boundary faces
 
       // "INSTANCE.NAME" of an assembly-level reference: the instance's
       // copy of a part's set, or an element or node number of the
@@ -205,9 +349,12 @@ namespace knee_contact
             for (const long long n : nodes)
               copy.push_back(node_offset + n);
           }
-        for (const auto &[id, edge] : part.line_elements)
-          model.line_elements[element_id(id)] = {node_offset + edge.first,
-                                                 node_offset + edge.second};
+        for (const auto &[id, facet] : part.facet_elements)
+          {
+            auto &copy = model.facet_elements[element_id(id)];
+            for (const long long n : facet)
+              copy.push_back(node_offset + n);
+          }
         for (const auto &[set, ids] : part.elsets)
           for (const long long id : ids)
             model.elsets[name + "." + set].insert(element_offset + id);
@@ -226,8 +373,9 @@ namespace knee_contact
           }
         for (const auto &surface : part.node_surfaces)
           model.node_surfaces.insert(name + "." + surface);
-        for (const auto &[set, id] : part.sections)
-          model.sections.emplace_back(name + "." + set, id);
+        for (const auto &section : part.sections)
+          model.sections.push_back(
+            {name + "." + section.elset, section.id, section.material});
         fail_if_too_many(model);
       };
 
@@ -246,6 +394,43 @@ namespace knee_contact
               const std::string keyword        = upper(keyword_fields[0]);
               block                            = "";
               set_instance                     = "";
+              // A *Material's definition is the keywords up to the next
+              // that is not one of its options.
+              const std::set<std::string> material_options = {"*ELASTIC",
+                                                              "*DENSITY",
+                                                              "*EXPANSION",
+                                                              "*DAMPING",
+                                                              "*CONDUCTIVITY",
+                                                              "*SPECIFIC HEAT"};
+              // Behaviours beyond linear elasticity: the material's constants
+              // are not all of it.
+              const std::set<std::string> beyond_elastic = {
+                "*PLASTIC",
+                "*HYPERELASTIC",
+                "*HYPOELASTIC",
+                "*HYPERFOAM",
+                "*VISCOELASTIC",
+                "*CREEP",
+                "*POROUS ELASTIC",
+                "*USER MATERIAL",
+                "*DRUCKER PRAGER",
+                "*MOHR COULOMB",
+                "*CAP PLASTICITY",
+                "*CRUSHABLE FOAM",
+                "*DAMAGE INITIATION",
+                "*DAMAGE EVOLUTION",
+                "*MULLINS EFFECT"};
+              if (open_material != nullptr &&
+                  beyond_elastic.count(keyword) != 0)
+                {
+                  if (open_material->problem.empty())
+                    open_material->problem =
+                      "it has " + keyword_fields[0] +
+                      " (knee_contact is linear elastic)";
+                  continue;
+                }
+              if (material_options.count(keyword) == 0)
+                open_material = nullptr;
               generate          = has_flag(keyword_fields, "GENERATE");
               const auto refuse = [&](const std::string &instead) {
                 deck.fail(keyword_fields[0] +
@@ -255,19 +440,7 @@ namespace knee_contact
               };
               if (keyword == "*INCLUDE")
                 {
-                  // The option's value as written (a path keeps its case).
-                  std::string path;
-                  for (std::size_t i = 1; i < keyword_fields.size(); ++i)
-                    {
-                      const auto equal = keyword_fields[i].find('=');
-                      if (equal != std::string::npos &&
-                          upper(trim(keyword_fields[i].substr(0, equal))) ==
-                            "INPUT")
-                        path = trim(keyword_fields[i].substr(equal + 1));
-                    }
-                  if (path.empty())
-                    deck.fail("*Include without INPUT=");
-                  deck.include(path);
+                  deck.include(include_input(keyword_fields, deck));
                 }
               else if (keyword == "*PART")
                 {
@@ -315,28 +488,31 @@ namespace knee_contact
                       ++n_data;
                       if (n_data == 1 && v.size() == 3)
                         {
-                          place.translation[0] =
-                            to_number(v[0], deck.current());
-                          place.translation[1] =
-                            to_number(v[1], deck.current());
-                          if (to_number(v[2], deck.current()) != 0)
+                          for (unsigned int d = 0; d < 3; ++d)
+                            place.translation[d] =
+                              to_number(v[d], deck.current());
+                          if (dim == 2 && place.translation[2] != 0)
                             deck.fail("an instance translated along z: "
-                                      "knee_contact meshes lie in the x-y "
-                                      "plane");
+                                      "2D meshes lie in the x-y plane");
                         }
                       else if (n_data == 2 && v.size() == 7)
                         {
                           std::array<double, 7> r;
                           for (unsigned int i = 0; i < 7; ++i)
                             r[i] = to_number(v[i], deck.current());
-                          if (r[0] != r[3] || r[1] != r[4] || r[2] == r[5])
+                          place.centre = Point<3>(r[0], r[1], r[2]);
+                          place.axis =
+                            Point<3>(r[3], r[4], r[5]) - place.centre;
+                          if (place.axis.norm() == 0)
                             deck.fail("an instance rotated about an axis "
-                                      "that is not parallel to z: "
-                                      "knee_contact meshes lie in the x-y "
-                                      "plane");
-                          place.centre = Point<2>(r[0], r[1]);
-                          place.angle =
-                            (r[5] > r[2] ? 1 : -1) * r[6] * numbers::PI / 180;
+                                      "from a point to itself");
+                          if (dim == 2 &&
+                              (place.axis[0] != 0 || place.axis[1] != 0))
+                            deck.fail("an instance rotated about an axis "
+                                      "that is not parallel to z: 2D "
+                                      "meshes lie in the x-y plane");
+                          place.axis /= place.axis.norm();
+                          place.angle = r[6] * numbers::PI / 180;
                         }
                       else
                         deck.fail("an *Instance data line is a translation "
@@ -357,30 +533,23 @@ namespace knee_contact
                     deck.fail("*Element in the assembly: knee_contact reads "
                               "elements of parts");
                   const std::string type = option(keyword_fields, "TYPE");
-                  const bool        plane =
-                    type.rfind("CPS", 0) == 0 || type.rfind("CPE", 0) == 0;
-                  const char n = type.size() > 3 ? type[3] : ' ';
-                  const std::set<std::string> line_types = {"T2D2",
-                                                            "T3D2",
-                                                            "T2D2H",
-                                                            "T3D2H",
-                                                            "B21",
-                                                            "B31",
-                                                            "B21H",
-                                                            "B31H"};
-                  if (line_types.count(type) != 0)
-                    n_element_nodes = 2;
-                  else if (!plane || (n != '3' && n != '4') ||
-                           type.find_first_not_of("RHI", 4) !=
-                             std::string::npos)
+                  n_element_nodes        = element_nodes(type, dim, dim);
+                  facets                 = n_element_nodes == 0;
+                  if (facets)
+                    n_element_nodes = element_nodes(type, dim - 1, dim);
+                  if (n_element_nodes == 0)
                     deck.fail(
-                      "element type '" + type +
-                      "' is not a linear plane element (knee_contact reads "
-                      "CPS3, CPE3, CPS4, CPE4 and their R, H, I variants, "
-                      "and two-node lines T2D2, T3D2, B21, B31 as boundary "
-                      "edges; mesh with linear elements)");
-                  else
-                    n_element_nodes = n - '0';
+                      "element type '" + type + "' is not a linear " +
+                      (dim == 2
+                         ? "plane element (a 2D deck: knee_contact reads "
+                           "CPS3, CPE3, CPS4, CPE4 and their R, H, I "
+                           "variants, and two-node lines T2D2, T3D2, "
+                           "B21, B31 as boundary edges"
+                         : "solid element (a 3D deck: knee_contact reads "
+                           "C3D4 and C3D8 and their R, H, I variants, "
+                           "and CPS3, CPE3, CPS4, CPE4, SFM3D3, SFM3D4 "
+                           "as boundary faces") +
+                      "; mesh with linear elements)");
                   block     = keyword;
                   block_set = option(keyword_fields, "ELSET");
                 }
@@ -427,7 +596,30 @@ namespace knee_contact
                   const std::string set = option(keyword_fields, "ELSET");
                   if (set.empty())
                     deck.fail("*Solid Section without ELSET");
-                  scope->sections.emplace_back(set, ++n_sections);
+                  scope->sections.push_back(
+                    {set, ++n_sections, option(keyword_fields, "MATERIAL")});
+                }
+              else if (keyword == "*MATERIAL")
+                {
+                  const std::string name = option(keyword_fields, "NAME");
+                  if (name.empty() || materials.count(name) != 0)
+                    deck.fail("*Material without a name, or a second "
+                              "*Material named '" +
+                              name + "'");
+                  open_material = &materials[name];
+                }
+              else if (keyword == "*ELASTIC")
+                {
+                  if (open_material == nullptr)
+                    deck.fail("*Elastic outside a *Material");
+                  const std::string type = option(keyword_fields, "TYPE");
+                  if (!type.empty() && type != "ISOTROPIC")
+                    open_material->problem = "*Elastic, type=" + type +
+                                             " (knee_contact's materials are "
+                                             "isotropic)";
+                  else if (!option(keyword_fields, "DEPENDENCIES").empty())
+                    open_material->problem = "*Elastic with field dependencies";
+                  block = keyword;
                 }
               else if (keyword == "*SHELL SECTION" ||
                        keyword == "*MEMBRANE SECTION")
@@ -452,21 +644,37 @@ namespace knee_contact
             }
 
           auto values = fields(text);
-          if (block == "*NODE")
+          if (block == "*ELASTIC")
+            {
+              // E, nu[, temperature]: one line is a constant material;
+              // more are a temperature table.
+              if (values.size() < 2 || values.size() > 3)
+                deck.fail("an isotropic *Elastic line is 'E, nu' (found " +
+                          std::to_string(values.size()) + " fields)");
+              if (open_material->elastic)
+                open_material->problem = "*Elastic depends on temperature";
+              open_material->elastic = true;
+              open_material->youngs_modulus =
+                to_number(values[0], deck.current());
+              open_material->poissons_ratio =
+                to_number(values[1], deck.current());
+            }
+          else if (block == "*NODE")
             {
               if (values.size() < 3 || values.size() > 4)
-                deck.fail("a node needs 'number, x, y' (found " +
+                deck.fail(std::string("a node needs 'number, x, y") +
+                          (dim == 3 ? ", z" : "") + "' (found " +
                           std::to_string(values.size()) + " fields)");
               const long long id = to_integer(values[0], deck.current());
               if (id < 0 || id > (1ll << 40))
                 deck.fail("node number " + values[0] + " out of range");
-              const Point<2> p(to_number(values[1], deck.current()),
-                               to_number(values[2], deck.current()));
-              if (values.size() == 4 &&
-                  to_number(values[3], deck.current()) != 0)
+              Point<3> p;
+              for (unsigned int d = 0; d + 1 < values.size(); ++d)
+                p[d] = to_number(values[d + 1], deck.current());
+              if (dim == 2 && p[2] != 0)
                 deck.fail("node " + values[0] +
-                          " has z != 0: knee_contact meshes lie in the x-y "
-                          "plane");
+                          " has z != 0 in a 2D deck: 2D meshes lie in the "
+                          "x-y plane");
               // Nodes of the assembly are reference points of rigid
               // bodies (refused where they are defined): not mesh.
               if (in_assembly)
@@ -510,12 +718,10 @@ namespace knee_contact
                   element.size())
                 deck.fail("element " + values[0] + " names a node twice");
               if (scope->elements.count(id) != 0 ||
-                  scope->line_elements.count(id) != 0)
+                  scope->facet_elements.count(id) != 0)
                 deck.fail("element " + values[0] + " appears twice");
-              if (element.size() == 2)
-                scope->line_elements.emplace(id,
-                                             std::minmax(element[0],
-                                                         element[1]));
+              if (facets)
+                scope->facet_elements.emplace(id, sorted(element));
               else
                 scope->elements.emplace(id, element);
               if (scope == &model)
@@ -595,11 +801,13 @@ namespace knee_contact
             }
           else if (block == "*SURFACE")
             {
+              const char last_face = dim == 2 ? '4' : '6';
               if (values.size() != 2 || values[1].size() != 2 ||
                   std::toupper(values[1][0]) != 'S' || values[1][1] < '1' ||
-                  values[1][1] > '4')
-                deck.fail("a surface line needs 'element or element set, "
-                          "S1..S4'");
+                  values[1][1] > last_face)
+                deck.fail(std::string("a surface line needs 'element or "
+                                      "element set, S1..S") +
+                          last_face + "'");
               if (in_assembly &&
                   std::isdigit(static_cast<unsigned char>(values[0][0])))
                 deck.fail("a surface of the assembly names element " +
@@ -613,7 +821,8 @@ namespace knee_contact
         deck.fail("the deck defines parts but no *Instance of them");
       AssertThrow(!model.elements.empty(),
                   ExcMessage("Mesh/File: '" + file +
-                             "' has no *Element lines with plane elements"));
+                             "' has no *Element lines with " +
+                             (dim == 2 ? "plane" : "solid") + " elements"));
 
       // A set the scene names: as written (upper case), or the one
       // instance's copy of it if only one instance has it.
@@ -641,8 +850,8 @@ namespace knee_contact
       // Material ids.
       std::map<std::string, unsigned int> material_of_set;
       if (element_sets.empty())
-        for (const auto &[set, id] : model.sections)
-          material_of_set.emplace(set, id);
+        for (const auto &section : model.sections)
+          material_of_set.emplace(section.elset, section.id);
       else
         for (const auto &[name, id] : element_sets)
           material_of_set.emplace(find_name(name, model.elsets), id);
@@ -655,8 +864,8 @@ namespace knee_contact
                                  "' has no element set '" + name + "'"));
           for (const long long e : set->second)
             {
-              if (model.line_elements.count(e) != 0)
-                continue; // boundary edges, not cells
+              if (model.facet_elements.count(e) != 0)
+                continue; // boundary faces, not cells
               AssertThrow(model.elements.count(e) != 0,
                           ExcMessage("Mesh/File: '" + file +
                                      "': element set '" + name +
@@ -680,12 +889,15 @@ namespace knee_contact
                                   : "name its set in the scene") +
                                ")"));
 
-      Description<2>                    mesh;
+      Description<dim>                  mesh;
       std::map<long long, unsigned int> vertex_of_node;
       for (const auto &[id, p] : model.nodes)
         {
           vertex_of_node[id] = mesh.vertices.size();
-          mesh.vertices.push_back(p);
+          Point<dim> q;
+          for (unsigned int d = 0; d < dim; ++d)
+            q[d] = p[d];
+          mesh.vertices.push_back(q);
         }
       for (const auto &[id, element] : model.elements)
         {
@@ -695,20 +907,70 @@ namespace knee_contact
           add_cell(mesh, vertices, material[id]);
         }
 
-      // Boundary ids: element faces of surfaces, or edges with both nodes
-      // in a node set; only faces on the boundary (one element) count.
-      std::map<std::pair<long long, long long>, unsigned int>
-        n_elements_of_edge;
+      // Each material id's *Material (its *Solid Section's MATERIAL=), for
+      // a scene that takes E and nu from the deck.
+      std::map<long long, std::string> material_name;
+      for (const auto &section : model.sections)
+        if (model.elsets.count(section.elset) != 0)
+          for (const long long e : model.elsets[section.elset])
+            material_name.emplace(e, section.material);
+      std::map<unsigned int, std::set<std::string>> names_of_id;
       for (const auto &[id, element] : model.elements)
-        for (unsigned int k = 0; k < element.size(); ++k)
+        names_of_id[material[id]].insert(
+          material_name.count(id) ? material_name[id] : "");
+      for (const auto &[id, names] : names_of_id)
+        {
+          DeckMaterial      &deck_material = mesh.deck_materials[id];
+          const std::string &name          = *names.begin();
+          deck_material.name               = name;
+          if (names.size() > 1)
+            deck_material.problem = "its cells have the materials '" + name +
+                                    "' and '" + *std::next(names.begin()) +
+                                    "' in the deck";
+          else if (name.empty())
+            deck_material.problem =
+              "no *Solid Section with MATERIAL= covers its cells";
+          else if (materials.count(name) == 0)
+            deck_material.problem =
+              "the deck has no *Material named '" + name + "'";
+          else if (!materials[name].problem.empty())
+            deck_material.problem =
+              "the deck's material '" + name + "': " + materials[name].problem;
+          else if (!materials[name].elastic)
+            deck_material.problem =
+              "the deck's material '" + name + "' has no *Elastic";
+          else
+            {
+              deck_material.youngs_modulus = materials[name].youngs_modulus;
+              deck_material.poissons_ratio = materials[name].poissons_ratio;
+            }
+        }
+
+      // Boundary ids: element faces of surfaces, facet elements of a set,
+      // or faces with all nodes in a node set; only faces on the boundary
+      // (one element) count. Faces are keyed by their sorted nodes.
+      std::map<std::vector<long long>, std::vector<long long>> face_of_key;
+      std::map<std::vector<long long>, unsigned int> n_elements_of_face;
+      for (const auto &[id, element] : model.elements)
+        for (unsigned int k = 0; k < (dim == 2              ? element.size()
+                                      : element.size() == 4 ? 4
+                                                            : 6);
+             ++k)
           {
-            auto e = face_nodes(element, k);
-            ++n_elements_of_edge[std::minmax(e.first, e.second)];
+            const auto face           = face_nodes<dim>(element, k);
+            face_of_key[sorted(face)] = face;
+            ++n_elements_of_face[sorted(face)];
           }
-      std::map<std::pair<long long, long long>, unsigned int> boundary_id;
+      const auto face_name = [](const std::vector<long long> &face) {
+        std::string text = "the face of nodes";
+        for (const long long n : face)
+          text += " " + std::to_string(n);
+        return text;
+      };
+      std::map<std::vector<long long>, unsigned int> boundary_id;
       for (const auto &[name, id] : boundary_sets)
         {
-          // A surface, else a set of line elements, else a node set.
+          // A surface, else a set of facet elements, else a node set.
           std::string key = find_name(name, model.surfaces);
           if (model.surfaces.count(key) == 0)
             {
@@ -734,70 +996,86 @@ namespace knee_contact
                   }
                 for (const long long e : owners)
                   {
-                    const auto element = model.elements.find(e);
+                    const auto   element = model.elements.find(e);
+                    const size_t n_faces = element == model.elements.end() ? 0
+                                           : dim == 2 ? element->second.size()
+                                           : element->second.size() == 4 ? 4
+                                                                         : 6;
                     AssertThrow(
-                      element != model.elements.end() &&
-                        face < element->second.size(),
+                      face < n_faces,
                       ExcMessage("Mesh/File: '" + file + "': surface '" + name +
                                  "' names face S" + std::to_string(face + 1) +
                                  " of element " + std::to_string(e) +
                                  ", which has no such face"));
-                    const auto edge = face_nodes(element->second, face);
-                    boundary_id[std::minmax(edge.first, edge.second)] = id;
+                    boundary_id[sorted(
+                      face_nodes<dim>(element->second, face))] = id;
                   }
               }
           else if (model.elsets.count(key) != 0 && !model.elsets[key].empty() &&
                    std::all_of(model.elsets[key].begin(),
                                model.elsets[key].end(),
                                [&](const long long e) {
-                                 return model.line_elements.count(e) != 0;
+                                 return model.facet_elements.count(e) != 0;
                                }))
             for (const long long e : model.elsets[key])
-              boundary_id[model.line_elements[e]] = id;
+              boundary_id[model.facet_elements[e]] = id;
           else if (model.nsets.count(key) != 0)
             {
               const auto &set = model.nsets[key];
-              for (const auto &[edge, n] : n_elements_of_edge)
-                if (n == 1 && set.count(edge.first) && set.count(edge.second))
-                  boundary_id[edge] = id;
+              for (const auto &[face, n] : n_elements_of_face)
+                if (n == 1 && std::all_of(face.begin(),
+                                          face.end(),
+                                          [&](const long long node) {
+                                            return set.count(node) != 0;
+                                          }))
+                  boundary_id[face] = id;
             }
           else
             AssertThrow(false,
                         ExcMessage("Mesh/Abaqus boundary sets: '" + file +
-                                   "' has no surface, node set or set of "
-                                   "line elements '" +
-                                   name + "'"));
+                                   "' has no surface, node set or set of " +
+                                   (dim == 2 ? "line" : "face") +
+                                   " elements '" + name + "'"));
           AssertThrow(boundary_id.size() > before,
                       ExcMessage("Mesh/Abaqus boundary sets: surface or node "
                                  "set '" +
-                                 name + "' of '" + file +
-                                 "' has no edge on the boundary"));
+                                 name + "' of '" + file + "' has no " +
+                                 (dim == 2 ? "edge" : "face") +
+                                 " on the boundary"));
         }
-      for (const auto &[edge, id] : boundary_id)
+      for (const auto &[key, id] : boundary_id)
         {
-          AssertThrow(n_elements_of_edge.count(edge) != 0,
+          AssertThrow(n_elements_of_face.count(key) != 0,
                       ExcMessage("Mesh/Abaqus boundary sets: '" + file +
-                                 "': the line from node " +
-                                 std::to_string(edge.first) + " to node " +
-                                 std::to_string(edge.second) +
-                                 " of boundary id " + std::to_string(id) +
-                                 " is no edge of a plane element"));
-          AssertThrow(n_elements_of_edge[edge] == 1,
+                                 "': " + face_name(key) + " of boundary id " +
+                                 std::to_string(id) + " is no face of a " +
+                                 (dim == 2 ? "plane" : "solid") + " element"));
+          AssertThrow(n_elements_of_face[key] == 1,
                       ExcMessage("Mesh/Abaqus boundary sets: '" + file +
-                                 "': the edge from node " +
-                                 std::to_string(edge.first) + " to node " +
-                                 std::to_string(edge.second) +
-                                 " of boundary id " + std::to_string(id) +
+                                 "': " + face_name(key) + " of boundary id " +
+                                 std::to_string(id) +
                                  " lies between two elements"));
-          add_boundary_line(mesh,
-                            vertex_of_node[edge.first],
-                            vertex_of_node[edge.second],
-                            id);
+          std::vector<unsigned int> vertices;
+          for (const long long node : face_of_key[key])
+            vertices.push_back(vertex_of_node[node]);
+          if constexpr (dim == 2)
+            add_boundary_line(mesh, vertices[0], vertices[1], id);
+          else
+            add_boundary_face(mesh, vertices, id);
         }
       GridTools::delete_unused_vertices(mesh.vertices,
                                         mesh.cells,
                                         mesh.subcells);
       return mesh;
     }
+
+    template Description<2>
+    read_abaqus(const std::string &,
+                const std::map<std::string, unsigned int> &,
+                const std::map<std::string, unsigned int> &);
+    template Description<3>
+    read_abaqus(const std::string &,
+                const std::map<std::string, unsigned int> &,
+                const std::map<std::string, unsigned int> &);
   } // namespace mesh_readers
 } // namespace knee_contact

@@ -181,28 +181,30 @@ namespace knee_contact
       }
 
       /**
-       * Abaqus' face k of a 2D element joins its nodes k and k+1 (the last
-       * back to the first).
+       * Add a cell whose @p vertices are listed as Abaqus, UCD and VTK list
+       * them: round a triangle or quadrilateral, a tetrahedron as it is,
+       * a hexahedron's bottom then top face each round it. deal.II's order
+       * is lexicographic (0 1 3 2 round a quadrilateral, 0 1 3 2 4 5 7 6
+       * for a hexahedron).
        */
-      inline std::pair<long long, long long>
-      face_nodes(const std::vector<long long> &nodes, const unsigned int k)
-      {
-        return {nodes[k], nodes[(k + 1) % nodes.size()]};
-      }
-
-      /**
-       * Add a triangle or quadrilateral whose @p vertices run round it, as
-       * Abaqus, UCD and VTK list them; deal.II's order is lexicographic
-       * (0 1 3 2 round a quadrilateral).
-       */
-      inline void
-      add_cell(Description<2>           &mesh,
+      template <int dim>
+      void
+      add_cell(Description<dim>         &mesh,
                std::vector<unsigned int> vertices,
                const types::material_id  material_id)
       {
-        if (vertices.size() == 4)
+        if (vertices.size() == 8)
+          vertices = {vertices[0],
+                      vertices[1],
+                      vertices[3],
+                      vertices[2],
+                      vertices[4],
+                      vertices[5],
+                      vertices[7],
+                      vertices[6]};
+        else if (dim == 2 && vertices.size() == 4)
           std::swap(vertices[2], vertices[3]);
-        CellData<2> cell(vertices.size());
+        CellData<dim> cell(vertices.size());
         cell.vertices    = vertices;
         cell.material_id = material_id;
         mesh.cells.push_back(cell);
@@ -218,6 +220,23 @@ namespace knee_contact
         line.vertices    = {a, b};
         line.boundary_id = boundary_id;
         mesh.subcells.boundary_lines.push_back(line);
+      }
+
+      /**
+       * A boundary triangle or quadrilateral of a 3D mesh whose @p vertices
+       * run round it.
+       */
+      inline void
+      add_boundary_face(Description<3>           &mesh,
+                        std::vector<unsigned int> vertices,
+                        const types::boundary_id  boundary_id)
+      {
+        if (vertices.size() == 4)
+          std::swap(vertices[2], vertices[3]);
+        CellData<2> face(vertices.size());
+        face.vertices    = vertices;
+        face.boundary_id = boundary_id;
+        mesh.subcells.boundary_quads.push_back(face);
       }
 
       /**
