@@ -438,18 +438,22 @@ namespace knee_contact
                           "it; " +
                           instead);
               };
+              // The NAME= of a *Part or *Material, which must be new.
+              const auto new_name = [&](const std::string &what,
+                                        const auto        &taken) {
+                const std::string name = option(keyword_fields, "NAME");
+                if (name.empty() || taken.count(name) != 0)
+                  deck.fail(what + " without a name, or a second " + what +
+                            " named '" + name + "'");
+                return name;
+              };
               if (keyword == "*INCLUDE")
                 {
                   deck.include(include_input(keyword_fields, deck));
                 }
               else if (keyword == "*PART")
                 {
-                  const std::string name = option(keyword_fields, "NAME");
-                  if (name.empty() || parts.count(name) != 0)
-                    deck.fail("*Part without a name, or a second *Part "
-                              "named '" +
-                              name + "'");
-                  scope = &parts[name];
+                  scope = &parts[new_name("*Part", parts)];
                 }
               else if (keyword == "*END PART")
                 {
@@ -535,8 +539,10 @@ namespace knee_contact
                   const std::string type = option(keyword_fields, "TYPE");
                   n_element_nodes        = element_nodes(type, dim, dim);
                   facets                 = n_element_nodes == 0;
-                  if (facets)
-                    n_element_nodes = element_nodes(type, dim - 1, dim);
+                  // Facets: faces of the cells, and in 3D also lines
+                  // (Gmsh writes physical curves so), which name no face.
+                  for (int d = dim - 1; d >= 1 && n_element_nodes == 0; --d)
+                    n_element_nodes = element_nodes(type, d, dim);
                   if (n_element_nodes == 0)
                     deck.fail(
                       "element type '" + type + "' is not a linear " +
@@ -601,12 +607,7 @@ namespace knee_contact
                 }
               else if (keyword == "*MATERIAL")
                 {
-                  const std::string name = option(keyword_fields, "NAME");
-                  if (name.empty() || materials.count(name) != 0)
-                    deck.fail("*Material without a name, or a second "
-                              "*Material named '" +
-                              name + "'");
-                  open_material = &materials[name];
+                  open_material = &materials[new_name("*Material", materials)];
                 }
               else if (keyword == "*ELASTIC")
                 {
@@ -619,7 +620,8 @@ namespace knee_contact
                                              "isotropic)";
                   else if (!option(keyword_fields, "DEPENDENCIES").empty())
                     open_material->problem = "*Elastic with field dependencies";
-                  block = keyword;
+                  else
+                    block = keyword; // its data lines: E, nu
                 }
               else if (keyword == "*SHELL SECTION" ||
                        keyword == "*MEMBRANE SECTION")
@@ -647,17 +649,26 @@ namespace knee_contact
           if (block == "*ELASTIC")
             {
               // E, nu[, temperature]: one line is a constant material;
-              // more are a temperature table.
-              if (values.size() < 2 || values.size() > 3)
-                deck.fail("an isotropic *Elastic line is 'E, nu' (found " +
-                          std::to_string(values.size()) + " fields)");
-              if (open_material->elastic)
+              // more are a temperature table. Only a scene that takes the
+              // constants from the deck needs them: what is not 'E, nu' is
+              // that material's problem, not the deck's.
+              const auto E  = values.size() >= 2 && values.size() <= 3
+                                ? input::number(values[0])
+                                : std::nullopt;
+              const auto nu = values.size() >= 2 && values.size() <= 3
+                                ? input::number(values[1])
+                                : std::nullopt;
+              if (!E || !nu)
+                open_material->problem =
+                  "its *Elastic line '" + text + "' is not 'E, nu'";
+              else if (open_material->elastic)
                 open_material->problem = "*Elastic depends on temperature";
+              else
+                {
+                  open_material->youngs_modulus = *E;
+                  open_material->poissons_ratio = *nu;
+                }
               open_material->elastic = true;
-              open_material->youngs_modulus =
-                to_number(values[0], deck.current());
-              open_material->poissons_ratio =
-                to_number(values[1], deck.current());
             }
           else if (block == "*NODE")
             {
