@@ -37,7 +37,12 @@ def main(folder):
     deformed = vertex[:, :, 0:3] + magnification * vertex[:, :, 3:6]
     stress = vertex[:, :, 6].mean(axis=1) / 1e6
     lower, upper = deformed.reshape(-1, 3).min(0), deformed.reshape(-1, 3).max(0)
-    norm = plt.Normalize(stress.min(), max(stress.max(), stress.min() + 1e-12))
+    low, high = stress.min(), stress.max()
+    if high - low <= 1e-6 * max(abs(high), 1e-300):
+        # A uniform field (a patch test): the scale from 0 to its value,
+        # not a range of round-off shown with an offset.
+        low, high = min(0.0, low), max(high, 1e-300)
+    norm = plt.Normalize(low, high)
     colours = plt.get_cmap("viridis")(norm(stress))
     figure = plt.figure(figsize=(12, 6))
     for k, (elevation, azimuth) in enumerate([(25, -60), (-25, 120)]):
