@@ -96,6 +96,26 @@ namespace knee_contact
                           "Slave vertices farther than this from the master "
                           "side [m] are not paired; 0: no limit.",
                           Patterns::Double(0));
+        input::add_selection(
+          prm,
+          "Friction",
+          interface.friction,
+          {{"none", Friction::none},
+           {"tresca", Friction::tresca},
+           {"coulomb", Friction::coulomb}},
+          "none: frictionless (zero tangential traction). coulomb: the "
+          "tangential traction is at most 'Friction coefficient' times the "
+          "contact pressure; the pair sticks below it and slips at it. "
+          "tresca: the same with the fixed bound 'Tresca bound'. 2D; the "
+          "scene is loaded in one step from the unloaded state.");
+        prm.add_parameter("Friction coefficient",
+                          interface.friction_coefficient,
+                          "mu >= 0 of Friction = coulomb.",
+                          Patterns::Double(0));
+        prm.add_parameter("Tresca bound",
+                          interface.tresca_bound,
+                          "The slip bound [Pa] of Friction = tresca.",
+                          Patterns::Double(0));
         prm.leave_subsection();
       }
     prm.leave_subsection();
@@ -113,6 +133,10 @@ namespace knee_contact
                           "Contact/Interface " + std::to_string(i) + "/Name");
         const std::string where =
           "Contact/Interface " + std::to_string(i) + ": ";
+        AssertThrow(std::isfinite(interface.friction_coefficient) &&
+                      std::isfinite(interface.tresca_bound),
+                    ExcMessage(where + "Friction coefficient and Tresca "
+                                       "bound must be finite"));
         AssertThrow(interface.slave_id != interface.master_id,
                     ExcMessage(where +
                                "slave and master boundary ids are "
@@ -354,6 +378,11 @@ namespace knee_contact
   {
     ContactPairs<2>                   pairs;
     std::set<types::global_dof_index> eliminated;
+    const bool                        friction =
+      std::any_of(list.begin(), list.end(), [](const ContactInterface &i) {
+        return i.friction != Friction::none;
+      });
+    std::vector<ContactRow> tangential, stick_x, stick_y;
     for (unsigned int i = 0; i < list.size(); ++i)
       {
         const ContactInterface &interface = list[i];
@@ -371,31 +400,94 @@ namespace knee_contact
           {
             ContactRow &pair       = rows.rows[p];
             const auto &slave_dofs = rows.points[p].slave_dofs;
-            reduce_row(pair, constraints);
-            // Eliminate the free slave component with the largest |n|,
-            // else the largest free other component.
-            for (const bool slave_side : {true, false})
+            // The tangential row: the rows list each vertex's (x, y)
+            // entries w n_x, w n_y in turn; w t with t = (-n_y, n_x).
+            ContactRow slide;
+            slide.interface = pair.interface;
+            slide.length    = pair.length;
+            for (std::size_t k = 0; k + 1 < pair.row.size(); k += 2)
               {
-                double largest = 0;
-                for (const auto &[dof, a] : pair.reduced_row)
-                  {
-                    const bool on_slave =
-                      dof == slave_dofs[0] || dof == slave_dofs[1];
-                    if (on_slave == slave_side && !eliminated.count(dof) &&
-                        std::abs(a) > largest + 1e-12)
-                      {
-                        largest         = std::abs(a);
-                        pair.eliminated = dof;
-                      }
-                  }
-                if (pair.eliminated != numbers::invalid_dof_index)
-                  break;
+                slide.row.emplace_back(pair.row[k].first,
+                                       -pair.row[k + 1].second);
+                slide.row.emplace_back(pair.row[k + 1].first,
+                                       pair.row[k].second);
               }
-            if (pair.eliminated != numbers::invalid_dof_index)
-              eliminated.insert(pair.eliminated);
+            // Eliminate the free slave component with the largest
+            // coefficient, else the largest free other component.
+            const auto choose = [&](ContactRow &row) {
+              reduce_row(row, constraints);
+              for (const bool slave_side : {true, false})
+                {
+                  double largest = 0;
+                  for (const auto &[dof, a] : row.reduced_row)
+                    {
+                      const bool on_slave =
+                        dof == slave_dofs[0] || dof == slave_dofs[1];
+                      if (on_slave == slave_side && !eliminated.count(dof) &&
+                          std::abs(a) > largest + 1e-12)
+                        {
+                          largest        = std::abs(a);
+                          row.eliminated = dof;
+                        }
+                    }
+                  if (row.eliminated != numbers::invalid_dof_index)
+                    break;
+                }
+              if (row.eliminated != numbers::invalid_dof_index)
+                eliminated.insert(row.eliminated);
+            };
+            // A sticking pair holds both rows; as rows they would
+            // eliminate the slave's two components in terms of each other
+            // (a cycle of constraints) wherever n is not along an axis. So
+            // a sticking pair is held by their combinations that isolate
+            // u_x and u_y of the slave: n_x N - n_y T and n_y N + n_x T
+            // (the slave part of both rows is the unit n and t).
+            ContactRow x_row, y_row;
+            if (friction)
+              {
+                const Tensor<1, 2> &n = rows.points[p].normal;
+                const auto combine    = [&](const double a, const double b) {
+                  ContactRow combined;
+                  combined.interface = pair.interface;
+                  combined.length    = pair.length;
+                  combined.gap       = a * pair.gap + b * slide.gap;
+                  for (std::size_t k = 0; k < pair.row.size(); ++k)
+                    combined.row.emplace_back(pair.row[k].first,
+                                              a * pair.row[k].second +
+                                                b * slide.row[k].second);
+                  return combined;
+                };
+                x_row = combine(n[0], -n[1]);
+                y_row = combine(n[1], n[0]);
+              }
+            choose(pair);
+            if (friction)
+              {
+                choose(slide);
+                tangential.push_back(std::move(slide));
+                // Never active together with the pair's N or T rows: they
+                // may eliminate the same dofs.
+                for (ContactRow *row : {&x_row, &y_row})
+                  {
+                    reduce_row(*row, constraints);
+                    double largest = 0;
+                    for (const auto &[dof, a] : row->reduced_row)
+                      if ((dof == slave_dofs[0] || dof == slave_dofs[1]) &&
+                          std::abs(a) > largest + 1e-12)
+                        {
+                          largest         = std::abs(a);
+                          row->eliminated = dof;
+                        }
+                  }
+                stick_x.push_back(std::move(x_row));
+                stick_y.push_back(std::move(y_row));
+              }
             pairs.push_back(std::move(pair), rows.points[p]);
           }
       }
+    pairs.tangential = std::move(tangential);
+    pairs.stick_x    = std::move(stick_x);
+    pairs.stick_y    = std::move(stick_y);
     return pairs;
   }
 

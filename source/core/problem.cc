@@ -313,13 +313,17 @@ namespace knee_contact
 
     boundary_conditions.make_constraints(dof_handler, constraints);
     contact_pairs = contact_interfaces.make_pairs(dof_handler, constraints);
+    friction_rows.clear();
+    if (!contact_pairs.tangential.empty())
+      friction_rows = contact_pairs.solver_rows();
 
     DynamicSparsityPattern mesh_pattern(dof_handler.n_dofs());
     DoFTools::make_sparsity_pattern(dof_handler, mesh_pattern);
     ActiveSetSolver::make_sparsity_pattern(mesh_pattern,
                                            constraints,
-                                           contact_pairs.rows,
-                                           sparsity_pattern);
+                                           rows_for_solver(),
+                                           sparsity_pattern,
+                                           !contact_pairs.tangential.empty());
     system_matrix.reinit(sparsity_pattern);
   }
 

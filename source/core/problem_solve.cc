@@ -147,25 +147,53 @@ namespace knee_contact
               make_contact_system(active_set_solver.linear_solver(),
                                   system_matrix,
                                   constraints,
-                                  contact_pairs.rows,
+                                  rows_for_solver(),
                                   !guess.empty(),
                                   output_writer.test_mode() ? quiet : loop_log,
                                   solver_name,
                                   solver_figures);
           }
-        contact_system->set_rhs(system_rhs);
-        contact_solution = active_set_solver.solve(*contact_system,
-                                                   system_rhs.linfty_norm(),
-                                                   constraints,
-                                                   contact_pairs.rows,
-                                                   rigid_modes,
-                                                   guess,
-                                                   loop_log);
+        if (contact_pairs.tangential.empty())
+          {
+            contact_system->set_rhs(system_rhs);
+            contact_solution = active_set_solver.solve(*contact_system,
+                                                       system_rhs.linfty_norm(),
+                                                       constraints,
+                                                       contact_pairs.rows,
+                                                       rigid_modes,
+                                                       guess,
+                                                       loop_log);
+          }
+        else
+          {
+            std::vector<FrictionBound> bounds(contact_pairs.size());
+            for (unsigned int p = 0; p < contact_pairs.size(); ++p)
+              {
+                const ContactRow       &row = contact_pairs.rows[p];
+                const ContactInterface &interface =
+                  contact_interfaces.interfaces()[row.interface];
+                if (interface.friction == Friction::coulomb)
+                  bounds[p] = {true, interface.friction_coefficient, {}};
+                else if (interface.friction == Friction::tresca)
+                  bounds[p] = {false, interface.tresca_bound * row.length, {}};
+                bounds[p].normal = {{contact_pairs.points[p].normal[0],
+                                     contact_pairs.points[p].normal[1]}};
+              }
+            contact_solution =
+              active_set_solver.solve_with_friction(*contact_system,
+                                                    system_rhs,
+                                                    constraints,
+                                                    friction_rows,
+                                                    bounds,
+                                                    rigid_modes,
+                                                    loop_log);
+          }
         contact_system->solution(displacement);
         solver_figures["contact_solve"] = clock.wall_time();
         for (const auto &[name, value] : contact_system->statistics())
           solver_figures[name] = value;
-        if (new_matrix && active_set_solver.measure_reference())
+        if (new_matrix && active_set_solver.measure_reference() &&
+            contact_pairs.tangential.empty())
           {
             Vector<double> x;
             solver_figures["reference_solve"] =

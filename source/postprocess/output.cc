@@ -312,6 +312,15 @@ namespace knee_contact
           {"force_on_slave", vector(i.force_on_slave)},
           {"max_pressure", i.max_pressure},
           {"contact_length", i.contact_length}};
+        if (!contact.lambda_t.empty())
+          {
+            auto &entry = summary["contact_interfaces"][i.name];
+            entry["tangential_force_on_slave"] =
+              vector(i.tangential_force_on_slave);
+            entry["n_stick"]  = i.n_stick;
+            entry["n_slip"]   = i.n_slip;
+            entry["max_slip"] = i.max_slip;
+          }
       }
     summary["n_contact_pairs"]       = n_pairs;
     summary["n_active_pairs"]        = n_active;

@@ -45,6 +45,10 @@ namespace knee_contact
     for (unsigned int p = 0; p < pairs.size(); ++p)
       for (const auto &[dof, a] : pairs.rows[p].row)
         support_force(dof) += a * contact.lambda[p];
+    // With friction the tangential forces T^T lambda_t too.
+    for (unsigned int p = 0; p < pairs.tangential.size(); ++p)
+      for (const auto &[dof, a] : pairs.tangential[p].row)
+        support_force(dof) += a * contact.lambda_t[p];
     // A hanging node's force belongs to the vertices it hangs from:
     // apply the transpose of its constraint.
     {
@@ -172,6 +176,19 @@ namespace knee_contact
         ++r.n_pairs;
         r.force += contact.lambda[p];
         r.force_on_slave -= contact.lambda[p] * pairs.points[p].normal;
+        if (!contact.lambda_t.empty())
+          {
+            // t = (-n_y, n_x) in 2D, as the tangential rows.
+            const Tensor<1, dim> &n = pairs.points[p].normal;
+            Tensor<1, dim>        t;
+            t[0] = -n[1];
+            t[1] = n[0];
+            r.tangential_force_on_slave -= contact.lambda_t[p] * t;
+            r.n_stick += contact.status[p] == ContactSolution::Status::stick;
+            r.n_slip += contact.status[p] == ContactSolution::Status::slip;
+            if (contact.status[p] == ContactSolution::Status::slip)
+              r.max_slip = std::max(r.max_slip, std::abs(contact.slip[p]));
+          }
         if (contact.active[p])
           {
             ++r.n_active;

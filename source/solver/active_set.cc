@@ -190,7 +190,8 @@ namespace knee_contact
     const DynamicSparsityPattern    &mesh_pattern,
     const AffineConstraints<double> &base,
     const std::vector<ContactRow>   &pairs,
-    SparsityPattern                 &sparsity_pattern)
+    SparsityPattern                 &sparsity_pattern,
+    const bool                       cycles_allowed)
   {
     // One sparsity pattern serves every active set. Condensing a set of
     // lines couples each dof i with the dofs its line refers to after
@@ -221,11 +222,33 @@ namespace knee_contact
       if (known != expansion.end())
         return known->second;
       // Lines that refer to each other in a cycle cannot be constraints; the
-      // elimination in make_pairs() is meant to prevent it.
+      // elimination in make_pairs() is meant to prevent it among rows that
+      // can be active together. With friction the normal and tangential
+      // rows of a pair may refer to each other, but they are never active
+      // together (a sticking pair is held by its X and Y rows): there the
+      // closure is the set of dofs reachable from i.
       if (!in_progress.insert(i).second)
-        throw std::logic_error("the contact rows eliminate dofs that refer "
-                               "to each other in a cycle (dof " +
-                               std::to_string(i) + ")");
+        {
+          if (!cycles_allowed)
+            throw std::logic_error("the contact rows eliminate dofs that "
+                                   "refer to each other in a cycle (dof " +
+                                   std::to_string(i) + ")");
+          std::set<types::global_dof_index>    reached = {i};
+          std::vector<types::global_dof_index> stack   = {i};
+          while (!stack.empty())
+            {
+              const auto k = stack.back();
+              stack.pop_back();
+              const auto it = one_level.find(k);
+              if (it != one_level.end())
+                for (const auto e : it->second)
+                  if (reached.insert(e).second)
+                    stack.push_back(e);
+            }
+          return expansion[i] =
+                   std::vector<types::global_dof_index>(reached.begin(),
+                                                        reached.end());
+        }
       std::set<types::global_dof_index> dofs = {i};
       const auto                        it   = one_level.find(i);
       if (it != one_level.end())

@@ -47,6 +47,31 @@ namespace knee_contact
   {
     std::vector<ContactRow>        rows;
     std::vector<ContactPoint<dim>> points;
+    /**
+     * With friction on any interface: for each row p the tangential row
+     * t_p . (u_slave - u_master) [rows[p]'s weights, the tangent
+     * t = (-n_y, n_x) in place of n], gap 0 (loaded in one step); empty
+     * if no interface has friction.
+     */
+    std::vector<ContactRow> tangential;
+    /**
+     * With friction: the rows that hold a sticking pair, n_x N - n_y T and
+     * n_y N + n_x T (see make_pairs).
+     */
+    std::vector<ContactRow> stick_x, stick_y;
+
+    /**
+     * The rows the solver sees: the normal rows, then the tangential, then
+     * stick_x and stick_y.
+     */
+    std::vector<ContactRow>
+    solver_rows() const
+    {
+      std::vector<ContactRow> all = rows;
+      for (const auto *more : {&tangential, &stick_x, &stick_y})
+        all.insert(all.end(), more->begin(), more->end());
+      return all;
+    }
 
     std::size_t
     size() const
@@ -96,6 +121,14 @@ namespace knee_contact
 
 
 
+  /** The friction law of an interface. */
+  enum class Friction
+  {
+    none,
+    tresca,
+    coulomb
+  };
+
   struct ContactInterface
   {
     std::string        name;
@@ -103,6 +136,11 @@ namespace knee_contact
     types::boundary_id master_id   = 0;
     Pairing            pairing     = Pairing::mortar;
     double             maximum_gap = 0;
+    Friction           friction    = Friction::none;
+    /** Coulomb: |tau_t| <= mu p. */
+    double friction_coefficient = 0;
+    /** Tresca: |tau_t| <= this bound [Pa]. */
+    double tresca_bound = 0;
   };
 
 

@@ -258,11 +258,24 @@ namespace knee_contact
 
     AffineConstraints<double> constraints;
     ContactPairs<dim>         contact_pairs;
-    SparsityPattern           sparsity_pattern;
-    SparseMatrix<double>      system_matrix;
-    Vector<double>            system_rhs;
-    Vector<double>            displacement;
-    ContactSolution           contact_solution;
+    /**
+     * With friction: the normal then the tangential rows, which the
+     * contact system keeps a reference to (see rows_for_solver()).
+     */
+    std::vector<ContactRow> friction_rows;
+
+    /** The rows the contact system and the active-set loop see. */
+    const std::vector<ContactRow> &
+    rows_for_solver() const
+    {
+      return contact_pairs.tangential.empty() ? contact_pairs.rows
+                                              : friction_rows;
+    }
+    SparsityPattern      sparsity_pattern;
+    SparseMatrix<double> system_matrix;
+    Vector<double>       system_rhs;
+    Vector<double>       displacement;
+    ContactSolution      contact_solution;
     /** The last cycle's factorised system, kept for further load cases. */
     std::unique_ptr<ContactSystem> contact_system;
     /**

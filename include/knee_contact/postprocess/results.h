@@ -37,6 +37,15 @@ namespace knee_contact
     double         max_pressure = 0;
     /** Length of slave boundary in contact, sum of the active shares [m]. */
     double contact_length = 0;
+    /**
+     * With friction: the tangential force on the slave body, -sum
+     * lambda_t,p t_p [N/m], the pairs that stick and slip, and the largest
+     * slip [m].
+     */
+    Tensor<1, dim> tangential_force_on_slave;
+    unsigned int   n_stick  = 0;
+    unsigned int   n_slip   = 0;
+    double         max_slip = 0;
   };
 
   /**

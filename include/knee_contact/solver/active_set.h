@@ -13,6 +13,7 @@
 #include <deal.II/lac/sparsity_pattern.h>
 #include <deal.II/lac/vector.h>
 
+#include <array>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -35,6 +36,38 @@ namespace knee_contact
     std::string  failure; // why not, if not converged
     double       complementarity = 0;
     double       max_penetration = 0; // max (A x - g)_p [m]
+
+    /**
+     * With friction (solve_with_friction()), per pair: the tangential
+     * multiplier [N/m] (the force t . tau on the slave), the tangential
+     * jump t . (u_slave - u_master) [m] (the slip of a slipping pair), and
+     * the status. Empty without friction.
+     */
+    std::vector<double> lambda_t;
+    std::vector<double> slip;
+    enum class Status
+    {
+      open,
+      stick,
+      slip
+    };
+    std::vector<Status> status;
+    /** Fixed-point updates of the Coulomb bounds after the sets settled. */
+    unsigned int n_bound_updates = 0;
+  };
+
+  /**
+   * The friction law of one contact pair for solve_with_friction(): the
+   * tangential multiplier is bounded by value x lambda_n (Coulomb, value =
+   * mu) or by value (Tresca, value = bound [Pa] x the pair's length:
+   * [N/m]); value 0: frictionless.
+   */
+  struct FrictionBound
+  {
+    bool   coulomb = false;
+    double value   = 0;
+    /** The pair's unit normal (2D), of which its X and Y rows are made. */
+    std::array<double, 2> normal{{0, 1}};
   };
 
 
@@ -113,14 +146,42 @@ namespace knee_contact
           std::ostream                    &log) const;
 
     /**
+     * The same loop with friction: @p rows are the n normal rows, the n
+     * tangential rows and the 2n rows that hold sticking pairs
+     * (ContactPairs::solver_rows()), @p bounds the
+     * law of each pair, @p rhs the load vector d (the slip forces are added
+     * to it in each iteration). Each iteration solves with the active
+     * normal rows and the sticking tangential rows as equalities and the
+     * slipping pairs' tangential forces prescribed, then updates
+     *   normal: as solve(); stick if |lambda_t + c (T x)_p| <= bound_p,
+     *   else slip with lambda_t = bound_p sign(lambda_t + c (T x)_p),
+     * with the Coulomb bound mu lambda_n of the last iterate (a fixed
+     * point on the bound: every system stays symmetric positive definite,
+     * so every solver path serves). A body that friction cannot hold is
+     * refused naming the ratio of the tangential to the normal force it
+     * needs.
+     */
+    ContactSolution
+    solve_with_friction(ContactSystem                    &system,
+                        const Vector<double>             &rhs,
+                        const AffineConstraints<double>  &base,
+                        const std::vector<ContactRow>    &rows,
+                        const std::vector<FrictionBound> &bounds,
+                        const RigidModeCheck             &rigid_modes,
+                        std::ostream                     &log) const;
+
+    /**
      * One sparsity pattern for the condensed systems of every active set of
-     * @p pairs under @p base (see the comment in the code).
+     * @p pairs under @p base (see the comment in the code);
+     * @p cycles_allowed with friction, whose rows are not all active
+     * together.
      */
     static void
     make_sparsity_pattern(const DynamicSparsityPattern    &mesh_pattern,
                           const AffineConstraints<double> &base,
                           const std::vector<ContactRow>   &pairs,
-                          SparsityPattern                 &sparsity_pattern);
+                          SparsityPattern                 &sparsity_pattern,
+                          const bool cycles_allowed = false);
 
     /**
      * The constraints of @p base plus the active rows of @p pairs, closed.

@@ -1,0 +1,248 @@
+#!/usr/bin/python3
+"""Friction (Coulomb) against independent references, loaded in one step.
+
+1. mu = 0 reproduces the frictionless results: each contact scene
+   (contact patch on matching and non-matching meshes, the mixed mesh, the
+   two-material Hertz, the sagittal knee) is run as it is and with
+   Friction = coulomb, Friction coefficient = 0 on every interface (both
+   on the sparse solver path); every number of summary.json (energy,
+   reactions, forces, pressures, stresses, ...) must agree to 1e-12
+   relative to the largest of its kind (the knee: 1e-10, see FRICTIONLESS).
+2. A very large mu reproduces the bonded solution on matching meshes: a
+   block (0.5 x 0.25, 4 x 2 cells) on a base (1 x 0.5, 8 x 4) with the
+   base's bottom held and the block's top loaded by (2e5, -1e6) Pa, with
+   mu = 1e3 (every pair sticks) against the same rectangles sharing their
+   vertices (bonded, no interface): energy, max |u| and reactions to 1e-10.
+3. Statics of the block, held by friction only (its sides free), load
+   ratio r = 0.2 tangential/normal: with mu = 0.5 > r it sticks and the
+   interface force (normal plus tangential on the slave) balances the
+   load to 1e-8 relative (node-to-node, node-to-segment and mortar); with
+   mu = 0.1 < r the run is refused in one line naming the ratio 0.2.
+Usage: friction.py KNEE_CONTACT
+"""
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SCENES = os.path.join(HERE, "..", "scenes")
+# Scene and tolerance. The rows of friction enter the sparsity pattern, so
+# the factorisation's ordering differs and the results differ by round-off:
+# 1e-14 on the patch tests, 8e-14 on Hertz; the knee's moduli span 1.1e9 to
+# 2e11, which amplifies it to 1.5e-11 (measured): 1e-10 there.
+FRICTIONLESS = [("contact_patch_matching.prm", 1e-12),
+                ("contact_patch_nonmatching.prm", 1e-12),
+                ("contact_patch_mixed.prm", 1e-12), ("hertz_small.prm", 1e-12),
+                ("knee_small.prm", 1e-10)]
+
+BLOCK = """
+subsection Mesh
+  set Source     = rectangles
+  set Rectangles = 0, 0, 1, 0.5, 8, 4, 1, 0, 1, 1, 2, 3; \\
+                   0.25, 0.5, 0.75, 0.75, 4, 2, 2, {group}, 4, 4, 5, 6
+end
+subsection Materials
+  set Number of materials = 2
+  subsection Material 0
+    set Material id     = 1
+    set Name            = base
+    set Young's modulus = 1e9
+    set Poisson's ratio = 0.3
+  end
+  subsection Material 1
+    set Material id     = 2
+    set Name            = block
+    set Young's modulus = 3e9
+    set Poisson's ratio = 0.2
+  end
+end
+subsection Boundary conditions
+  set Number of conditions = 2
+  subsection Condition 0
+    set Boundary ids = 2
+    set Type         = displacement
+  end
+  subsection Condition 1
+    set Boundary ids = 6
+    set Type         = traction
+    set Value        = 2e5; -1e6
+  end
+end
+subsection Contact
+  set Number of interfaces = {n_interfaces}
+{interface}
+end
+subsection Output
+  set Folder   = {folder}
+  set Pictures = false
+end
+"""
+
+INTERFACE = """  subsection Interface 0
+    set Name                 = block
+    set Slave boundary id    = 5
+    set Master boundary id   = 3
+    set Pairing              = {pairing}
+    set Friction             = coulomb
+    set Friction coefficient = {mu}
+  end"""
+
+
+def run(binary, text, folder, name, expect_success=True):
+    scene = os.path.join(folder, name + ".prm")
+    with open(scene, "w") as f:
+        f.write(text)
+    result = subprocess.run([binary, scene], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    if not expect_success:
+        return result
+    if result.returncode != 0:
+        print(result.stdout[-2000:], result.stderr)
+        raise SystemExit("%s: exit code %d" % (name, result.returncode))
+    with open(os.path.join(folder, name, "summary.json")) as f:
+        return json.load(f)
+
+
+def numbers(value, path=""):
+    """(path, number) of summary.json but timings, solver figures and the
+    friction entries (which the frictionless run has not)."""
+    if isinstance(value, dict):
+        for k, v in value.items():
+            if k in ("wall_time", "solver", "tangential_force_on_slave",
+                     "n_stick", "n_slip", "max_slip",
+                     "active_set_iterations"):
+                continue
+            yield from numbers(v, path + "/" + k)
+    elif isinstance(value, list):
+        for i, v in enumerate(value):
+            yield from numbers(v, path + "[%d]" % i)
+    elif isinstance(value, (int, float)) and not isinstance(value, bool):
+        yield path, float(value)
+
+
+def compare(name, reference, other, tolerance):
+    a, b = dict(numbers(reference)), dict(numbers(other))
+    assert a.keys() == b.keys(), (name, a.keys() ^ b.keys())
+    worst, failures = 0.0, 0
+    for key in a:
+        top = key.split("/")[1]
+        if top in ("equilibrium_residual", "relative_max_penetration",
+                   "complementarity_residual", "max_penetration"):
+            continue  # round-off measures
+        scale = max(abs(v) for k, v in a.items()
+                    if k.split("/")[1] == top) or 1.0
+        error = abs(a[key] - b[key]) / scale
+        worst = max(worst, error)
+        if error > tolerance:
+            print("FAIL %s: %s = %r, reference %r" % (name, key, b[key],
+                                                     a[key]))
+            failures += 1
+    print("%s: %d numbers, largest relative difference %.1e (tolerance "
+          "%.0e)" % (name, len(a), worst, tolerance))
+    return failures
+
+
+def with_output(text, folder):
+    """The scene with its files written into folder."""
+    text = re.sub(r"\n\s*set Terminal\s*=.*", "", text)
+    text = re.sub(r"\n\s*set Write files\s*=.*", "", text)
+    text = re.sub(r"\n\s*set Folder\s*=.*", "", text)
+    return text.replace("subsection Output",
+                        "subsection Output\n  set Folder = %s\n"
+                        "  set Pictures = false" % folder, 1)
+
+
+def main():
+    binary = os.path.abspath(sys.argv[1])
+    failures = 0
+    with tempfile.TemporaryDirectory() as folder:
+        # 1. mu = 0.
+        for scene, tolerance in FRICTIONLESS:
+            text = open(os.path.join(SCENES, scene)).read()
+            # Relative paths of the scene (meshes) from the scenes folder.
+            text = re.sub(r"(set File\s*=\s*)(\S+)",
+                          lambda m: m.group(1) + os.path.normpath(
+                              os.path.join(SCENES, m.group(2))), text)
+            name = scene[:-4]
+            # One linear solver path for both (the automatic choice weighs
+            # the number of rows, which friction doubles; paths differ by
+            # round-off).
+            text = re.sub(r"\n\s*set Solver\s*=.*", "", text)
+            text = text.replace("subsection Contact",
+                                "subsection Contact\n  set Solver = sparse", 1)
+            plain = run(binary, with_output(text, os.path.join(folder, name)),
+                        folder, name)
+            frictional = re.sub(
+                r"(\n(\s*)subsection Interface \d+)",
+                lambda m: m.group(1) + "\n" + m.group(2) +
+                "  set Friction = coulomb\n" + m.group(2) +
+                "  set Friction coefficient = 0", text)
+            assert frictional != text
+            other = run(binary,
+                        with_output(frictional,
+                                    os.path.join(folder, name + "_mu0")),
+                        folder, name + "_mu0")
+            failures += compare(name + ", mu = 0", plain, other, tolerance)
+
+        # 2. Very large mu against bonded rectangles.
+        bonded = run(binary, BLOCK.format(
+            group=0, n_interfaces=0, interface="",
+            folder=os.path.join(folder, "bonded")), folder, "bonded")
+        sticking = run(binary, BLOCK.format(
+            group=1, n_interfaces=1,
+            interface=INTERFACE.format(pairing="node-to-node", mu=1e3),
+            folder=os.path.join(folder, "sticking")), folder, "sticking")
+        assert sticking["contact_interfaces"]["block"]["n_slip"] == 0
+        for key in ("energy", "max_displacement"):
+            error = abs(sticking[key] - bonded[key]) / abs(bonded[key])
+            print("mu = 1e3 against bonded: %s %.1e (tolerance 1e-10)"
+                  % (key, error))
+            failures += error > 1e-10
+        for k, v in bonded["reactions"].items():
+            w = sticking["reactions"][k]
+            reaction = w if isinstance(w, list) else w["force"]
+            reference = v if isinstance(v, list) else v["force"]
+            error = max(abs(x - y) for x, y in zip(reaction, reference)) / \
+                max(abs(x) for x in reference)
+            print("mu = 1e3 against bonded: reaction %s %.1e (tolerance "
+                  "1e-10)" % (k, error))
+            failures += error > 1e-10
+
+        # 3. Statics of the block held by friction.
+        load = (2e5 * 0.5, -1e6 * 0.5)
+        for pairing in ("node-to-node", "node-to-segment", "mortar"):
+            name = "statics_" + pairing
+            summary = run(binary, BLOCK.format(
+                group=1, n_interfaces=1,
+                interface=INTERFACE.format(pairing=pairing, mu=0.5),
+                folder=os.path.join(folder, name)), folder, name)
+            interface = summary["contact_interfaces"]["block"]
+            total = [interface["force_on_slave"][d] +
+                     interface["tangential_force_on_slave"][d] + load[d]
+                     for d in range(2)]
+            error = max(abs(x) for x in total) / abs(load[1])
+            print("%s, mu = 0.5 > 0.2: interface force + load = %s, "
+                  "relative %.1e (tolerance 1e-8); %d sticking"
+                  % (pairing, total, error, interface["n_stick"]))
+            failures += error > 1e-8
+            refused = run(binary, BLOCK.format(
+                group=1, n_interfaces=1,
+                interface=INTERFACE.format(pairing=pairing, mu=0.1),
+                folder=os.path.join(folder, name + "_slides")), folder,
+                name + "_slides", expect_success=False)
+            lines = refused.stderr.strip().splitlines()
+            ok = (refused.returncode == 1 and len(lines) == 1 and
+                  "friction cannot hold it" in lines[0] and
+                  "tangential/normal force 0.2)" in lines[0])
+            print("%s, mu = 0.1 < 0.2: exit %d, %s" %
+                  (pairing, refused.returncode, lines[-1] if lines else ""))
+            failures += not ok
+    if failures:
+        raise SystemExit("%d failures" % failures)
+
+
+if __name__ == "__main__":
+    main()
