@@ -88,6 +88,17 @@ namespace knee_contact
                             active,
                             "add a displacement or sliding boundary, or "
                             "bring it into contact (zero gap)");
+        // Without a slipping pair the load pulls a body off its contact,
+        // as in solve(); with one, friction lets it go.
+        if (std::none_of(active.begin(), active.begin() + n, [](bool a) {
+              return a;
+            }))
+          rigid_modes.check(base,
+                            rows,
+                            active,
+                            "at active-set iteration " +
+                              std::to_string(iteration) +
+                              " its load pulls it off its contact pairs");
         const std::string free = rigid_modes.free_motion(base, rows, active);
         if (!free.empty())
           {
