@@ -251,15 +251,6 @@ namespace knee_contact
               constraints.add_line(dofs[d]);
         }
     }
-
-    template <int dim>
-    void
-    sliding_constraints_on_simplices(const DoFHandler<dim> &,
-                                     const std::set<types::boundary_id> &,
-                                     AffineConstraints<double> &)
-    {
-      Assert(false, ExcInternalError());
-    }
   } // namespace
 
 
@@ -295,12 +286,17 @@ namespace knee_contact
     if (!sliding.empty())
       {
         AffineConstraints<double> sliding_constraints;
-        if (dim == 3 && !dof_handler.get_triangulation()
-                           .all_reference_cells_are_hyper_cube())
-          sliding_constraints_on_simplices(dof_handler,
-                                           sliding,
-                                           sliding_constraints);
-        else
+        bool                      done = false;
+        if constexpr (dim == 3)
+          if (!dof_handler.get_triangulation()
+                 .all_reference_cells_are_hyper_cube())
+            {
+              sliding_constraints_on_simplices(dof_handler,
+                                               sliding,
+                                               sliding_constraints);
+              done = true;
+            }
+        if (!done)
           VectorTools::compute_no_normal_flux_constraints(dof_handler,
                                                           0,
                                                           sliding,

@@ -323,6 +323,32 @@ namespace knee_contact
 
 
 
+  void
+  ActiveSetSolver::close_until_held(
+    const AffineConstraints<double>         &base,
+    const std::vector<ContactRow>           &rows,
+    std::vector<unsigned int>                candidates,
+    const RigidModeCheck                    &rigid_modes,
+    const std::vector<bool>                 &active,
+    const std::function<void(unsigned int)> &close)
+  {
+    std::stable_sort(candidates.begin(),
+                     candidates.end(),
+                     [&rows](const unsigned int a, const unsigned int b) {
+                       return rows[a].gap < rows[b].gap;
+                     });
+    for (std::size_t closed = 0;
+         closed < candidates.size() &&
+         !rigid_modes.free_motion(base, rows, active).empty();)
+      {
+        const std::size_t next = std::min(candidates.size(), 2 * closed + 1);
+        for (; closed < next; ++closed)
+          close(candidates[closed]);
+      }
+  }
+
+
+
   ContactSolution
   ActiveSetSolver::solve(ContactSystem                   &system,
                          const double                     force_scale_of_load,
@@ -350,19 +376,14 @@ namespace knee_contact
           else
             by_gap.push_back(p);
         }
-    std::stable_sort(by_gap.begin(),
-                     by_gap.end(),
-                     [&pairs](const unsigned int a, const unsigned int b) {
-                       return pairs[a].gap < pairs[b].gap;
+    close_until_held(base,
+                     pairs,
+                     by_gap,
+                     rigid_modes,
+                     result.active,
+                     [&result](const unsigned int p) {
+                       result.active[p] = true;
                      });
-    for (std::size_t closed = 0;
-         closed < by_gap.size() &&
-         !rigid_modes.free_motion(base, pairs, result.active).empty();)
-      {
-        const std::size_t next = std::min(by_gap.size(), 2 * closed + 1);
-        for (; closed < next; ++closed)
-          result.active[by_gap[closed]] = true;
-      }
 
     std::set<std::vector<bool>> seen;
     std::vector<double>         excesses;

@@ -56,21 +56,10 @@ namespace knee_contact
           else
             by_gap.push_back(p);
         }
-    // As solve() does: a body only contact holds may need more; close the
-    // smallest gaps first, doubling their number, until every body is held.
-    std::stable_sort(by_gap.begin(),
-                     by_gap.end(),
-                     [&rows](const unsigned int a, const unsigned int b) {
-                       return rows[a].gap < rows[b].gap;
-                     });
-    for (std::size_t closed = 0;
-         closed < by_gap.size() &&
-         !rigid_modes.free_motion(base, rows, active).empty();)
-      {
-        const std::size_t next = std::min(by_gap.size(), 2 * closed + 1);
-        for (; closed < next; ++closed)
-          set_state(active, by_gap[closed], true, can_stick(by_gap[closed]));
-      }
+    // As solve() does: a body only contact holds may need more.
+    close_until_held(base, rows, by_gap, rigid_modes, active, [&](auto p) {
+      set_state(active, p, true, can_stick(p));
+    });
     // The prescribed tangential multipliers of the slipping pairs.
     std::vector<double> slip_force(n, 0.);
     // What the bodies need of friction, measured while everything sticks
@@ -108,7 +97,8 @@ namespace knee_contact
             for (const auto &[interface, forces] : needed)
               if (forces.second > 0)
                 what << " (interface " << interface << ": tangential/normal "
-                     << "force " << forces.first / forces.second << ")";
+                     << "force " << std::abs(forces.first) / forces.second
+                     << ")";
             AssertThrow(false,
                         ExcMessage(
                           free +
@@ -152,9 +142,6 @@ namespace knee_contact
                 t += lambda[n + p];
                 normal += lambda[p];
               }
-        if (iteration == 1)
-          for (auto &[interface, forces] : needed)
-            forces.first = std::abs(forces.first);
 
         double lambda_scale = 0;
         for (const double l : lambda)

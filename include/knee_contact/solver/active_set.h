@@ -14,6 +14,7 @@
 #include <deal.II/lac/vector.h>
 
 #include <array>
+#include <functional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -169,6 +170,20 @@ namespace knee_contact
                         const std::vector<FrictionBound> &bounds,
                         const RigidModeCheck             &rigid_modes,
                         std::ostream                     &log) const;
+
+    /**
+     * Where contact alone must hold a body: @p close the pairs of
+     * @p candidates (not in contact yet) in the order of their gaps,
+     * doubling their number, until no rigid motion is free under @p base
+     * and the rows marked in @p active (which @p close updates).
+     */
+    static void
+    close_until_held(const AffineConstraints<double>         &base,
+                     const std::vector<ContactRow>           &rows,
+                     std::vector<unsigned int>                candidates,
+                     const RigidModeCheck                    &rigid_modes,
+                     const std::vector<bool>                 &active,
+                     const std::function<void(unsigned int)> &close);
 
     /**
      * One sparsity pattern for the condensed systems of every active set of
