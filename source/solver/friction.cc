@@ -195,6 +195,16 @@ namespace knee_contact
                            std::max(0., std::abs(t_force) - bound) /
                              lambda_scale);
               }
+            else if (!active[p] && s != 0)
+              {
+                // A pair that comes into contact slips the way it moved
+                // while open (the large-c limit of the complementarity
+                // test). Held at once, its whole tangential displacement
+                // would be undone in one step: starting so, the sagittal
+                // knee took 40 iterations instead of 15 at mu = 0.04.
+                stick     = false;
+                direction = s > 0 ? 1 : -1;
+              }
             else if (active[p])
               {
                 if (slip_force[p] == 0)
