@@ -11,6 +11,7 @@
 
 #include <deal.II/lac/sparse_direct.h>
 
+#include <array>
 #include <cmath>
 #include <functional>
 #include <iomanip>
@@ -139,7 +140,20 @@ namespace knee_contact
     try
       {
         Timer clock;
-        if (new_matrix)
+        // Along a load path with friction (a further case on the same
+        // matrix) each case starts where the previous one ended: a pair
+        // sticks where it is, so the tangential rows' gaps become the
+        // current tangential jumps, and the slip accumulates. The contact
+        // systems keep what depends on the gaps (a factorisation under
+        // inhomogeneous constraints), so the system is made anew.
+        const bool path_step = !new_matrix && !contact_pairs.tangential.empty();
+        std::vector<double> accumulated(contact_pairs.size(), 0.);
+        if (path_step)
+          {
+            hold_tangential_rows_at(displacement);
+            accumulated = contact_solution.accumulated_slip;
+          }
+        if (new_matrix || path_step)
           {
             solver_figures.clear();
             contact_system.reset();
@@ -186,7 +200,16 @@ namespace knee_contact
                                                     friction_rows,
                                                     bounds,
                                                     rigid_modes,
+                                                    guess,
                                                     loop_log);
+            if (contact_solution.status.size() == contact_pairs.size())
+              {
+                for (unsigned int p = 0; p < contact_pairs.size(); ++p)
+                  if (contact_solution.status[p] ==
+                      ContactSolution::Status::slip)
+                    accumulated[p] += std::abs(contact_solution.slip[p]);
+                contact_solution.accumulated_slip = std::move(accumulated);
+              }
           }
         contact_system->solution(displacement);
         solver_figures["contact_solve"] = clock.wall_time();
@@ -239,6 +262,34 @@ namespace knee_contact
                              " to " +
                              std::to_string(materials.max_youngs_modulus()) +
                              " Pa); choose units that keep them near 1"));
+  }
+
+
+
+  template <int dim>
+  void
+  ContactProblem<dim>::hold_tangential_rows_at(const Vector<double> &u)
+  {
+    // friction_rows: N (n), T (n), X = n_x N - n_y T, Y = n_y N + n_x T.
+    const unsigned int n = contact_pairs.size();
+    for (unsigned int p = 0; p < n; ++p)
+      {
+        ContactRow &t_row = friction_rows[n + p];
+        double      jump  = 0;
+        for (const auto &[dof, a] : t_row.row)
+          jump += a * u(dof);
+        const double shift  = jump - t_row.gap;
+        const auto  &normal = contact_pairs.points[p].normal;
+        const std::array<std::pair<ContactRow *, double>, 3> moved = {
+          {{&t_row, 1.},
+           {&friction_rows[2 * n + p], -normal[1]},
+           {&friction_rows[3 * n + p], normal[0]}}};
+        for (const auto &[row, weight] : moved)
+          {
+            row->gap += weight * shift;
+            row->reduced_gap += weight * shift;
+          }
+      }
   }
 
 

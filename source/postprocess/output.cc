@@ -317,9 +317,12 @@ namespace knee_contact
             auto &entry = summary["contact_interfaces"][i.name];
             entry["tangential_force_on_slave"] =
               vector(i.tangential_force_on_slave);
-            entry["n_stick"]  = i.n_stick;
-            entry["n_slip"]   = i.n_slip;
-            entry["max_slip"] = i.max_slip;
+            entry["n_stick"]              = i.n_stick;
+            entry["n_slip"]               = i.n_slip;
+            entry["stick_length"]         = i.stick_length;
+            entry["slip_length"]          = i.slip_length;
+            entry["max_slip"]             = i.max_slip;
+            entry["max_accumulated_slip"] = i.max_accumulated_slip;
           }
       }
     summary["n_contact_pairs"]       = n_pairs;

@@ -151,6 +151,44 @@ namespace knee_contact
       std::vector<DataComponentInterpretation::DataComponentInterpretation>(
         dim, DataComponentInterpretation::component_is_scalar));
 
+    // With friction (2D): tangential traction and status (0 open, 1
+    // stick, 2 slip) in one vector, this case's and the accumulated slip in
+    // another.
+    Vector<double> traction_field, slip_field;
+    if (!contact.status.empty())
+      {
+        traction_field.reinit(dof_handler.n_dofs());
+        slip_field.reinit(dof_handler.n_dofs());
+        for (unsigned int p = 0; p < pairs.size(); ++p)
+          {
+            const auto &dofs = pairs.points[p].slave_dofs;
+            traction_field(dofs[0]) =
+              contact.lambda_t[p] / pairs.rows[p].length;
+            traction_field(dofs[1]) = static_cast<int>(contact.status[p]);
+            slip_field(dofs[0])     = contact.slip[p];
+            slip_field(dofs[1])     = contact.accumulated_slip[p];
+          }
+        for (const auto &[field, names] :
+             {std::make_pair(&traction_field,
+                             std::vector<std::string>{"tangential_traction",
+                                                      "friction_status"}),
+              std::make_pair(&slip_field,
+                             std::vector<std::string>{"slip",
+                                                      "accumulated_slip"})})
+          {
+            std::vector<std::string> all = names;
+            if (dim == 3)
+              all.emplace_back("unused");
+            data_out.add_data_vector(
+              *field,
+              all,
+              DataOut<dim>::type_dof_data,
+              std::vector<
+                DataComponentInterpretation::DataComponentInterpretation>(
+                dim, DataComponentInterpretation::component_is_scalar));
+          }
+      }
+
     Vector<float> material_id(body_of_cell.size()),
       body_id(body_of_cell.size());
     for (const auto &cell : dof_handler.active_cell_iterators())
@@ -290,8 +328,16 @@ namespace knee_contact
         write_file(name, [&](std::ostream &out) {
           // The discretisation in every row, so that a CSV read on its
           // own says how its pressure was computed.
+          // With friction: the tangential traction lambda_t / length
+          // along t = (-n_y, n_x) [Pa], this case's slip t . (u_slave -
+          // u_master) increment [m], the slip accumulated along the load
+          // path [m] and the status.
+          const bool friction = !contact.status.empty();
           out << "arc_length,x,y,n_x,n_y,gap,jump,pressure,active,"
-                 "discretisation\n"
+              << (friction ? "tangential_traction,slip,accumulated_slip,"
+                             "status,"
+                           : "")
+              << "discretisation\n"
               << std::setprecision(10);
           double s = 0;
           for (unsigned int k = 0; k < order.size(); ++k)
@@ -305,8 +351,13 @@ namespace knee_contact
                   << ',' << point.normal[0] << ',' << point.normal[1] << ','
                   << row.gap << ',' << row.jump(solution) << ','
                   << results.pressure[order[k]] << ','
-                  << (contact.active[order[k]] ? 1 : 0) << ','
-                  << pairing_name(results.interfaces[i].pairing) << '\n';
+                  << (contact.active[order[k]] ? 1 : 0) << ',';
+              if (friction)
+                out << contact.lambda_t[order[k]] / row.length << ','
+                    << contact.slip[order[k]] << ','
+                    << contact.accumulated_slip[order[k]] << ','
+                    << status_name(contact.status[order[k]]) << ',';
+              out << pairing_name(results.interfaces[i].pairing) << '\n';
             }
         });
       }

@@ -184,10 +184,20 @@ namespace knee_contact
             t[0] = -n[1];
             t[1] = n[0];
             r.tangential_force_on_slave -= contact.lambda_t[p] * t;
-            r.n_stick += contact.status[p] == ContactSolution::Status::stick;
-            r.n_slip += contact.status[p] == ContactSolution::Status::slip;
+            if (contact.status[p] == ContactSolution::Status::stick)
+              {
+                ++r.n_stick;
+                r.stick_length += pairs.rows[p].length;
+              }
             if (contact.status[p] == ContactSolution::Status::slip)
-              r.max_slip = std::max(r.max_slip, std::abs(contact.slip[p]));
+              {
+                ++r.n_slip;
+                r.slip_length += pairs.rows[p].length;
+                r.max_slip = std::max(r.max_slip, std::abs(contact.slip[p]));
+              }
+            if (p < contact.accumulated_slip.size())
+              r.max_accumulated_slip =
+                std::max(r.max_accumulated_slip, contact.accumulated_slip[p]);
           }
         if (contact.active[p])
           {

@@ -21,8 +21,9 @@ namespace knee_contact
                                        const AffineConstraints<double>  &base,
                                        const std::vector<ContactRow>    &rows,
                                        const std::vector<FrictionBound> &bounds,
-                                       const RigidModeCheck &rigid_modes,
-                                       std::ostream         &log) const
+                                       const RigidModeCheck    &rigid_modes,
+                                       const std::vector<bool> &guess,
+                                       std::ostream            &log) const
   {
     using Status         = ContactSolution::Status;
     const unsigned int n = bounds.size();
@@ -44,14 +45,16 @@ namespace knee_contact
       state[2 * n + p] = contact && stick;
       state[3 * n + p] = contact && stick;
     };
-    // Start with the touching pairs in contact and sticking: the state in
+    // Start with the touching pairs (or those of the guess: the previous
+    // load case's contact zone) in contact and sticking: the state in
     // which friction holds the most.
+    AssertThrow(guess.empty() || guess.size() == n, ExcInternalError());
     std::vector<bool>         active(4 * n, false);
     std::vector<unsigned int> by_gap;
     for (unsigned int p = 0; p < n; ++p)
       if (rows[p].eliminated != numbers::invalid_dof_index)
         {
-          if (rows[p].gap <= 0)
+          if (guess.empty() ? rows[p].gap <= 0 : bool(guess[p]))
             set_state(active, p, true, can_stick(p));
           else
             by_gap.push_back(p);
@@ -231,23 +234,28 @@ namespace knee_contact
             << result.complementarity << ", slip force change "
             << force_change / force_scale << std::defaultfloat << std::endl;
 
+        // The pairs' figures of this iteration, also when it fails (the
+        // results of a failed case are still reported, and a study or a
+        // load path reads them).
+        result.active.assign(n, false);
+        result.status.assign(n, Status::open);
+        result.slip.assign(n, 0.);
+        for (unsigned int p = 0; p < n; ++p)
+          if (in_contact(p))
+            {
+              result.active[p] = true;
+              result.status[p] =
+                active[2 * n + p] ? Status::stick : Status::slip;
+              // The slip of a pair in contact (an open pair's tangential
+              // jump is no slip).
+              if (result.status[p] == Status::slip)
+                result.slip[p] = excess[n + p];
+            }
+        result.lambda.assign(lambda.begin(), lambda.begin() + n);
+        result.lambda_t.assign(lambda.begin() + n, lambda.begin() + 2 * n);
         if (next == active && force_change <= tolerance * force_scale &&
             result.complementarity <= tolerance)
-          {
-            result.active.resize(n);
-            result.status.assign(n, Status::open);
-            for (unsigned int p = 0; p < n; ++p)
-              {
-                result.active[p] = in_contact(p);
-                if (in_contact(p))
-                  result.status[p] =
-                    active[2 * n + p] ? Status::stick : Status::slip;
-              }
-            result.lambda.assign(lambda.begin(), lambda.begin() + n);
-            result.lambda_t.assign(lambda.begin() + n, lambda.begin() + 2 * n);
-            result.slip.assign(excess.begin() + n, excess.begin() + 2 * n);
-            return result;
-          }
+          return result;
         if (next == active && force_change <= tolerance * force_scale)
           {
             result.converged = false;

@@ -112,7 +112,8 @@ def numbers(value, path=""):
     if isinstance(value, dict):
         for k, v in value.items():
             if k in ("wall_time", "solver", "tangential_force_on_slave",
-                     "n_stick", "n_slip", "max_slip",
+                     "n_stick", "n_slip", "max_slip", "stick_length",
+                     "slip_length", "max_accumulated_slip",
                      "active_set_iterations"):
                 continue
             yield from numbers(v, path + "/" + k)

@@ -264,6 +264,14 @@ namespace knee_contact
      */
     std::vector<ContactRow> friction_rows;
 
+    /**
+     * With friction, along a load path: the gaps of the tangential rows
+     * (and of the rows that hold sticking pairs) become the tangential
+     * jumps of @p u, so that a pair sticks where it is.
+     */
+    void
+    hold_tangential_rows_at(const Vector<double> &u);
+
     /** The rows the contact system and the active-set loop see. */
     const std::vector<ContactRow> &
     rows_for_solver() const

@@ -39,13 +39,17 @@ namespace knee_contact
     double contact_length = 0;
     /**
      * With friction: the tangential force on the slave body, -sum
-     * lambda_t,p t_p [N/m], the pairs that stick and slip, and the largest
-     * slip [m].
+     * lambda_t,p t_p [N/m], the pairs that stick and slip and their
+     * shares of the slave side [m], the largest slip of this load case
+     * and the largest accumulated along the load path [m].
      */
     Tensor<1, dim> tangential_force_on_slave;
-    unsigned int   n_stick  = 0;
-    unsigned int   n_slip   = 0;
-    double         max_slip = 0;
+    unsigned int   n_stick              = 0;
+    unsigned int   n_slip               = 0;
+    double         stick_length         = 0;
+    double         slip_length          = 0;
+    double         max_slip             = 0;
+    double         max_accumulated_slip = 0;
   };
 
   /**

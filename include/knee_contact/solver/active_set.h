@@ -46,6 +46,12 @@ namespace knee_contact
      */
     std::vector<double> lambda_t;
     std::vector<double> slip;
+    /**
+     * Along a load path (Load cases/Values of t with friction): per pair
+     * the slip of this case is its increment since the previous case, and
+     * this the sum of the increments' magnitudes since the first case [m].
+     */
+    std::vector<double> accumulated_slip;
     enum class Status
     {
       open,
@@ -56,6 +62,21 @@ namespace knee_contact
     /** Fixed-point updates of the Coulomb bounds after the sets settled. */
     unsigned int n_bound_updates = 0;
   };
+
+  /** "open", "stick" or "slip": the status as the CSVs write it. */
+  inline std::string
+  status_name(const ContactSolution::Status status)
+  {
+    switch (status)
+      {
+        case ContactSolution::Status::stick:
+          return "stick";
+        case ContactSolution::Status::slip:
+          return "slip";
+        default:
+          return "open";
+      }
+  }
 
   /**
    * The friction law of one contact pair for solve_with_friction(): the
@@ -149,18 +170,21 @@ namespace knee_contact
     /**
      * The same loop with friction: @p rows are the n normal rows, the n
      * tangential rows and the 2n rows that hold sticking pairs
-     * (ContactPairs::solver_rows()), @p bounds the
-     * law of each pair, @p rhs the load vector d (the slip forces are added
-     * to it in each iteration). Each iteration solves with the active
-     * normal rows and the sticking tangential rows as equalities and the
-     * slipping pairs' tangential forces prescribed, then updates
-     *   normal: as solve(); stick if |lambda_t + c (T x)_p| <= bound_p,
-     *   else slip with lambda_t = bound_p sign(lambda_t + c (T x)_p),
-     * with the Coulomb bound mu lambda_n of the last iterate (a fixed
-     * point on the bound: every system stays symmetric positive definite,
-     * so every solver path serves). A body that friction cannot hold is
-     * refused naming the ratio of the tangential to the normal force it
-     * needs.
+     * (ContactPairs::solver_rows(); the tangential rows' gaps are where
+     * the pairs stuck last, so their excess is the slip of this step),
+     * @p bounds the law of each pair, @p rhs the load vector d (the slip
+     * forces are added to it in each iteration). Each iteration solves
+     * with the active normal rows and the sticking pairs' rows as
+     * equalities and the slipping pairs' tangential forces prescribed,
+     * then decides: normal contact as solve(); a sticking pair slips where
+     * |lambda_t| exceeds its bound, a slipping pair sticks where it would
+     * slip against its force, a pair that comes into contact slips the way
+     * it moved while open; the Coulomb bound mu lambda_n of the last
+     * iterate (a fixed point on the bound: every system stays symmetric
+     * positive definite, so every solver path serves). The pairs marked in
+     * @p guess (if not empty) start in contact and sticking, else those
+     * with zero gap. A body that friction cannot hold is refused naming
+     * the ratio of the tangential to the normal force it needs.
      */
     ContactSolution
     solve_with_friction(ContactSystem                    &system,
@@ -169,6 +193,7 @@ namespace knee_contact
                         const std::vector<ContactRow>    &rows,
                         const std::vector<FrictionBound> &bounds,
                         const RigidModeCheck             &rigid_modes,
+                        const std::vector<bool>          &guess,
                         std::ostream                     &log) const;
 
     /**
