@@ -290,6 +290,49 @@ namespace knee_contact
 
 
 
+  /**
+   * Node-to-segment: x + s n = p0 + xi (p1 - p0), the closest master face
+   * facing the slave (n_master . n < 0) along the slave normal n.
+   */
+  struct MasterHit
+  {
+    const ContactSides::Face *face = nullptr;
+    double                    s    = std::numeric_limits<double>::max();
+    double                    xi   = 0;
+  };
+
+  MasterHit
+  master_along_normal(const ContactSides &sides,
+                      const Point<2>     &position,
+                      const Tensor<1, 2> &n,
+                      const double        length)
+  {
+    MasterHit hit;
+    for (const ContactSides::Face &m : sides.master_faces)
+      {
+        if (m.normal * n >= 0)
+          continue;
+        const Tensor<1, 2> t   = m.vertices[1] - m.vertices[0];
+        const Tensor<1, 2> r   = m.vertices[0] - position;
+        const double       det = -n[0] * t[1] + n[1] * t[0];
+        if (std::abs(det) < 1e-12 * t.norm())
+          continue;
+        const double s  = (-r[0] * t[1] + r[1] * t[0]) / det;
+        const double xi = (n[0] * r[1] - n[1] * r[0]) / det;
+        if (xi < -1e-10 || xi > 1 + 1e-10 || s < -2 * length)
+          continue;
+        if (std::abs(s) < std::abs(hit.s))
+          {
+            hit.s    = s;
+            hit.xi   = std::clamp(xi, 0., 1.);
+            hit.face = &m;
+          }
+      }
+    return hit;
+  }
+
+
+
   ContactPairs<2>
   node_to_segment_rows(const ContactSides     &sides,
                        const ContactInterface &interface,
@@ -301,30 +344,11 @@ namespace knee_contact
       {
         const Tensor<1, 2> n   = slave.unit_normal();
         const double       tol = 1e-8 * sides.min_length;
-        // Node-to-segment: x + s n = p0 + xi (p1 - p0), the closest
-        // master face facing the slave (n_master . n < 0) along n.
-        double best_s = std::numeric_limits<double>::max(), best_xi = 0;
-        const ContactSides::Face *best = nullptr;
-        for (const ContactSides::Face &m : sides.master_faces)
-          {
-            if (m.normal * n >= 0)
-              continue;
-            const Tensor<1, 2> t   = m.vertices[1] - m.vertices[0];
-            const Tensor<1, 2> r   = m.vertices[0] - slave.position;
-            const double       det = -n[0] * t[1] + n[1] * t[0];
-            if (std::abs(det) < 1e-12 * t.norm())
-              continue;
-            const double s  = (-r[0] * t[1] + r[1] * t[0]) / det;
-            const double xi = (n[0] * r[1] - n[1] * r[0]) / det;
-            if (xi < -1e-10 || xi > 1 + 1e-10 || s < -2 * slave.length)
-              continue;
-            if (std::abs(s) < std::abs(best_s))
-              {
-                best_s  = s;
-                best_xi = std::clamp(xi, 0., 1.);
-                best    = &m;
-              }
-          }
+        const MasterHit    hit =
+          master_along_normal(sides, slave.position, n, slave.length);
+        double                    best_s  = hit.s;
+        double                    best_xi = hit.xi;
+        const ContactSides::Face *best    = hit.face;
         if (best != nullptr && std::abs(best_s) <= tol)
           best_s = 0;
         if (best != nullptr && (best_xi < 1e-8 || best_xi > 1 - 1e-8) &&
@@ -363,7 +387,7 @@ namespace knee_contact
               for (unsigned int d = 0; d < 2; ++d)
                 pair.row.emplace_back(best->dofs[v][d], -weight * n[d]);
           }
-        pairs.push_back(std::move(pair), {slave.position, n, slave.dofs});
+        pairs.push_back(std::move(pair), {slave.position, n, slave.dofs, {}});
       }
     return pairs;
   }
@@ -401,16 +425,33 @@ namespace knee_contact
             ContactRow &pair       = rows.rows[p];
             const auto &slave_dofs = rows.points[p].slave_dofs;
             // The tangential row: the rows list each vertex's (x, y)
-            // entries w n_x, w n_y in turn; w t with t = (-n_y, n_x).
+            // entries w n_x, w n_y in turn; w t in their place, t the
+            // tangent of the common normal n - n_master where the slave
+            // normal meets the master (of n alone where it meets none).
+            Tensor<1, 2> &t = rows.points[p].tangent;
+            {
+              const Tensor<1, 2> &n   = rows.points[p].normal;
+              const MasterHit     hit = master_along_normal(sides,
+                                                        rows.points[p].position,
+                                                        n,
+                                                        pair.length);
+              Tensor<1, 2>        m   = n;
+              if (hit.face != nullptr)
+                m -= hit.face->normal;
+              m /= m.norm();
+              t[0] = -m[1];
+              t[1] = m[0];
+            }
             ContactRow slide;
             slide.interface = pair.interface;
             slide.length    = pair.length;
             for (std::size_t k = 0; k + 1 < pair.row.size(); k += 2)
               {
-                slide.row.emplace_back(pair.row[k].first,
-                                       -pair.row[k + 1].second);
-                slide.row.emplace_back(pair.row[k + 1].first,
-                                       pair.row[k].second);
+                const Tensor<1, 2> &n = rows.points[p].normal;
+                const double        w =
+                  pair.row[k].second * n[0] + pair.row[k + 1].second * n[1];
+                slide.row.emplace_back(pair.row[k].first, w * t[0]);
+                slide.row.emplace_back(pair.row[k + 1].first, w * t[1]);
               }
             // Eliminate the free slave component with the largest
             // coefficient, else the largest free other component.
@@ -440,8 +481,8 @@ namespace knee_contact
             // eliminate the slave's two components in terms of each other
             // (a cycle of constraints) wherever n is not along an axis. So
             // a sticking pair is held by their combinations that isolate
-            // u_x and u_y of the slave: n_x N - n_y T and n_y N + n_x T
-            // (the slave part of both rows is the unit n and t).
+            // u_x and u_y of the slave (the slave parts of N and T are n
+            // and t): stick_coefficients().
             ContactRow x_row, y_row;
             if (friction)
               {
@@ -457,8 +498,9 @@ namespace knee_contact
                                                 b * slide.row[k].second);
                   return combined;
                 };
-                x_row = combine(n[0], -n[1]);
-                y_row = combine(n[1], n[0]);
+                const auto c = stick_coefficients(n, t);
+                x_row        = combine(c[0][0], c[0][1]);
+                y_row        = combine(c[1][0], c[1][1]);
               }
             choose(pair);
             if (friction)

@@ -224,7 +224,7 @@ namespace knee_contact
           if (M != 0)
             for (unsigned int d = 0; d < 2; ++d)
               pair.row.emplace_back(dofs[d], -M / weight * n[d]);
-        pairs.push_back(std::move(pair), {vertex.position, n, vertex.dofs});
+        pairs.push_back(std::move(pair), {vertex.position, n, vertex.dofs, {}});
       }
     return pairs;
   }

@@ -190,8 +190,10 @@ namespace knee_contact
                   bounds[p] = {true, interface.friction_coefficient, {}};
                 else if (interface.friction == Friction::tresca)
                   bounds[p] = {false, interface.tresca_bound * row.length, {}};
-                bounds[p].normal = {{contact_pairs.points[p].normal[0],
-                                     contact_pairs.points[p].normal[1]}};
+                if constexpr (dim == 2)
+                  bounds[p].stick =
+                    stick_coefficients(contact_pairs.points[p].normal,
+                                       contact_pairs.points[p].tangent);
               }
             contact_solution =
               active_set_solver.solve_with_friction(*contact_system,
@@ -270,7 +272,7 @@ namespace knee_contact
   void
   ContactProblem<dim>::hold_tangential_rows_at(const Vector<double> &u)
   {
-    // friction_rows: N (n), T (n), X = n_x N - n_y T, Y = n_y N + n_x T.
+    // friction_rows: N (n), T (n), X = a_x N + b_x T, Y = a_y N + b_y T.
     const unsigned int n = contact_pairs.size();
     for (unsigned int p = 0; p < n; ++p)
       {
@@ -278,12 +280,15 @@ namespace knee_contact
         double      jump  = 0;
         for (const auto &[dof, a] : t_row.row)
           jump += a * u(dof);
-        const double shift  = jump - t_row.gap;
-        const auto  &normal = contact_pairs.points[p].normal;
+        const double                         shift = jump - t_row.gap;
+        std::array<std::array<double, 2>, 2> c{{{{0, 0}}, {{0, 0}}}};
+        if constexpr (dim == 2)
+          c = stick_coefficients(contact_pairs.points[p].normal,
+                                 contact_pairs.points[p].tangent);
         const std::array<std::pair<ContactRow *, double>, 3> moved = {
           {{&t_row, 1.},
-           {&friction_rows[2 * n + p], -normal[1]},
-           {&friction_rows[3 * n + p], normal[0]}}};
+           {&friction_rows[2 * n + p], c[0][1]},
+           {&friction_rows[3 * n + p], c[1][1]}}};
         for (const auto &[row, weight] : moved)
           {
             row->gap += weight * shift;

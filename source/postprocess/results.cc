@@ -178,12 +178,9 @@ namespace knee_contact
         r.force_on_slave -= contact.lambda[p] * pairs.points[p].normal;
         if (!contact.lambda_t.empty())
           {
-            // t = (-n_y, n_x) in 2D, as the tangential rows.
-            const Tensor<1, dim> &n = pairs.points[p].normal;
-            Tensor<1, dim>        t;
-            t[0] = -n[1];
-            t[1] = n[0];
-            r.tangential_force_on_slave -= contact.lambda_t[p] * t;
+            // Along the tangent of the tangential row.
+            r.tangential_force_on_slave -=
+              contact.lambda_t[p] * pairs.points[p].tangent;
             if (contact.status[p] == ContactSolution::Status::stick)
               {
                 ++r.n_stick;

@@ -122,14 +122,14 @@ namespace knee_contact
         system.set_rhs(load);
         system.solve(active, excess, lambda);
         // lambda_n and lambda_t of each pair: of a sticking pair from the
-        // multipliers of X = n_x N - n_y T and Y = n_y N + n_x T.
+        // multipliers of its X and Y rows (stick_coefficients()).
         for (unsigned int p = 0; p < n; ++p)
           if (active[2 * n + p])
             {
-              const double nx = bounds[p].normal[0], ny = bounds[p].normal[1];
+              const auto  &c  = bounds[p].stick;
               const double lx = lambda[2 * n + p], ly = lambda[3 * n + p];
-              lambda[p]     = nx * lx + ny * ly;
-              lambda[n + p] = -ny * lx + nx * ly;
+              lambda[p]     = lx * c[0][0] + ly * c[1][0];
+              lambda[n + p] = lx * c[0][1] + ly * c[1][1];
             }
           else
             lambda[n + p] = active[p] ? slip_force[p] : 0.;

@@ -33,13 +33,28 @@ the friction coefficient,
 where q* is the loaded state's traction (the formulas above, the second
 term only within its half-width): |x| < c' sticks, c' < |x| < a slips back.
 
-Asserted, with tolerances from the mesh study (--study, README 'Friction'):
+Mesh study (--study; the finest row took 2 minutes, the first, which
+ctest runs, 11 s), errors of q in units of mu p0 (loaded in one step,
+along the path, unloaded) and of c in mesh spacings:
+   d       h      a/R    |c_h - c|/h      max |q_h - q| / (mu p0)
+  0.0005  0.002   0.0097  0.31 0.31 0.07   0.0198 0.0198 0.0154
+  0.0005  0.001   0.0097  0.28 0.28 0.17   0.0256 0.0256 0.0242
+  0.0005  0.0005  0.0097  0.07 0.07 0.18   0.0259 0.0259 0.0252
+  0.002   0.001   0.0209  1.02 1.02 0.24   0.0497 0.0497 0.0496
+  0.002   0.0005  0.0209  0.59 0.59 0.06   0.0618 0.0618 0.0611
+The traction error converges in h to about 2.8 a/R: the finite discs are
+not half-spaces (Cattaneo's solution is the limit a/R -> 0). With the
+slave's own tangent in the tangential rows instead of the common one it
+was 0.12 to 0.20 at a/R = 0.021 (the tilt of the normals counted part of
+the normal approach as slip). Asserted at a/R = 0.0097, h = 0.002
+(measured: c to 0.31 h, q to 0.020 mu p0, unloaded 0.016):
   the stick half-width c (the outermost sticking vertex, plus half a mesh
-  spacing) to 1.5 mesh spacings h (0.005 here); the tangential traction q in
-  |x| < 0.9 c against q(x) above to 2 % of mu p0; the tangential force
-  equals Q to 1e-8 relative; the one-step and the path results agree to
-  1 % of mu p0 (the path's discrete stick set may differ by a vertex);
-  after unloading, c' to 1.5 h and q in |x| < 0.9 c' to 3 % of mu p0.
+  spacing) to 1 h, loaded and unloaded; the tangential traction q in
+  |x| < c - h (and, unloaded, not within h of the loaded stick zone's end,
+  where q has a kink) to 0.035 mu p0; the interface's x-force against the
+  upper disc's balance to 1e-8 relative; the one-step and the path results
+  to 1e-8 mu p0 (the CSVs' 10 digits: Cattaneo's solution does not depend
+  on the path while Q grows, and the discrete sets agree).
 Usage: cattaneo_mindlin.py KNEE_CONTACT [--study]
 """
 import csv
@@ -243,25 +258,25 @@ def main():
                        f["c_one"], f["c_path"], f["c_back"], f["q_one"],
                        f["q_path"], f["q_back"]))
             return
-        f = measure(binary, folder, 0.002, 0.0005)
+        f = measure(binary, folder, 0.004, 0.0005)
         print("P = %.6e, Q = %.6e, a = %.5f, c = %.5f, h = %.4f" %
               (f["P"], f["Q"], f["a"], f["c"], f["h"]))
         failures = check("stick half-width, one step, |c_h - c| / h",
-                         f["c_one"], 1.5, failures)
+                         f["c_one"], 1.0, failures)
         failures = check("stick half-width, path, |c_h - c| / h",
-                         f["c_path"], 1.5, failures)
-        failures = check("traction in 0.9 c, one step, / (mu p0)",
-                         f["q_one"], 0.02, failures)
-        failures = check("traction in 0.9 c, path, / (mu p0)",
-                         f["q_path"], 0.02, failures)
+                         f["c_path"], 1.0, failures)
+        failures = check("traction in |x| < c - h, one step, / (mu p0)",
+                         f["q_one"], 0.035, failures)
+        failures = check("traction in |x| < c - h, path, / (mu p0)",
+                         f["q_path"], 0.035, failures)
         failures = check("interface x-force against the upper disc's balance",
                          f["force"], 1e-8, failures)
         failures = check("one step against path, / (mu p0)",
-                         f["one_vs_path"], 0.01, failures)
+                         f["one_vs_path"], 1e-8, failures)
         failures = check("unloaded stick half-width, |c'_h - c'| / h",
-                         f["c_back"], 1.5, failures)
-        failures = check("unloaded traction in 0.9 c', / (mu p0)",
-                         f["q_back"], 0.03, failures)
+                         f["c_back"], 1.0, failures)
+        failures = check("unloaded traction in |x| < c' - h, / (mu p0)",
+                         f["q_back"], 0.035, failures)
     if failures:
         raise SystemExit("%d check(s) failed" % failures)
 

@@ -35,7 +35,31 @@ namespace knee_contact
     Tensor<1, dim> normal;
     /** Dof indices of the slave vertex (x, y[, z]). */
     std::array<types::global_dof_index, dim> slave_dofs;
+    /**
+     * With friction (2D): the unit tangent of the pair's tangential row,
+     * that of the common normal n - n_master (n_master: the master face
+     * the slave normal meets), t = (-m_y, m_x) for m the common normal.
+     * On curved sides both normals tilt over the contact zone; the slave's
+     * alone would count part of the normal approach as slip.
+     */
+    Tensor<1, dim> tangent;
   };
+
+
+
+  /**
+   * The combinations a N + b T of a pair's normal and tangential rows
+   * whose slave parts (n and t) are e_x and e_y: {{a_x, b_x}, {a_y, b_y}},
+   * the inverse of the matrix with columns n and t. A sticking pair is
+   * held by these two rows; their multipliers l_x, l_y are
+   * lambda_n = l_x a_x + l_y a_y and lambda_t = l_x b_x + l_y b_y.
+   */
+  inline std::array<std::array<double, 2>, 2>
+  stick_coefficients(const Tensor<1, 2> &n, const Tensor<1, 2> &t)
+  {
+    const double det = n[0] * t[1] - n[1] * t[0];
+    return {{{{t[1] / det, -n[1] / det}}, {{-t[0] / det, n[0] / det}}}};
+  }
 
 
 
@@ -50,13 +74,14 @@ namespace knee_contact
     /**
      * With friction on any interface: for each row p the tangential row
      * t_p . (u_slave - u_master) [rows[p]'s weights, the tangent
-     * t = (-n_y, n_x) in place of n], gap 0 (loaded in one step); empty
-     * if no interface has friction.
+     * points[p].tangent in place of n], gap 0 (loaded in one step; along
+     * a load path the last case's jump); empty if no interface has
+     * friction.
      */
     std::vector<ContactRow> tangential;
     /**
-     * With friction: the rows that hold a sticking pair, n_x N - n_y T and
-     * n_y N + n_x T (see make_pairs).
+     * With friction: the rows that hold a sticking pair, the combinations
+     * of N and T whose slave parts are e_x and e_y (see make_pairs).
      */
     std::vector<ContactRow> stick_x, stick_y;
 

@@ -88,8 +88,12 @@ namespace knee_contact
   {
     bool   coulomb = false;
     double value   = 0;
-    /** The pair's unit normal (2D), of which its X and Y rows are made. */
-    std::array<double, 2> normal{{0, 1}};
+    /**
+     * How the pair's X and Y rows (which hold it while it sticks) combine
+     * its normal and tangential rows: {{a_x, b_x}, {a_y, b_y}}, see
+     * stick_coefficients() (2D).
+     */
+    std::array<std::array<double, 2>, 2> stick{{{{0, 0}}, {{0, 0}}}};
   };
 
 
