@@ -7,7 +7,12 @@ draws, each written to a temporary name and renamed:
                         asks, the seed's Fig. 2) over the undeformed outline,
                         bodies coloured by material, labelled points;
   stress_yy.png         the vertical stress tau_yy in MPa (the seed's Fig. 3);
-  contact_pressure.png  the contact pressure in MPa along each interface.
+  contact_pressure.png  the contact pressure in MPa along each interface;
+  contact_friction.png  with friction: along each frictional interface the
+                        normal and tangential traction in MPa (and the
+                        bound mu p where it is Coulomb), the slip of this
+                        load case and the accumulated slip in micrometres,
+                        sticking vertices marked.
 Usage: plot_results.py FOLDER
 """
 import csv
@@ -116,6 +121,47 @@ def contact_pressure(folder):
     save(figure, os.path.join(folder, "contact_pressure.png"))
 
 
+def contact_friction(folder):
+    """Tractions and slip along each interface that has friction columns."""
+    tables = []
+    for path in sorted(glob.glob(os.path.join(folder, "contact_*.csv"))):
+        with open(path) as f:
+            rows = list(csv.DictReader(f))
+        if rows and "tangential_traction" in rows[0]:
+            tables.append((os.path.basename(path)[len("contact_"):-4], rows))
+    if not tables:
+        return
+    figure, axes = plt.subplots(2, len(tables), figsize=(8 * len(tables), 7),
+                                squeeze=False, sharex="col")
+    for column, (name, rows) in enumerate(tables):
+        s = np.array([float(r["arc_length"]) for r in rows]) * 1e3
+        p = np.array([float(r["pressure"]) for r in rows]) / 1e6
+        q = np.array([float(r["tangential_traction"]) for r in rows]) / 1e6
+        slip = np.array([float(r["slip"]) for r in rows]) * 1e6
+        total = np.array([float(r["accumulated_slip"]) for r in rows]) * 1e6
+        stick = np.array([r["status"] == "stick" for r in rows])
+        top, bottom = axes[0][column], axes[1][column]
+        top.plot(s, p, ".-", label="normal traction (pressure)")
+        top.plot(s, q, ".-", label="tangential traction")
+        top.plot(s[stick], q[stick], "o", mfc="none", color="k",
+                 label="sticking")
+        top.set_ylabel("traction [MPa]")
+        top.set_title(name)
+        bottom.plot(s, slip, ".-", label="slip of this load case")
+        bottom.plot(s, total, ".-", label="accumulated slip")
+        bottom.set_ylabel("slip [um]")
+        bottom.set_xlabel("arc length along the slave side [mm]")
+        # Where the sides touch, with a margin of a fifth on either side.
+        touching = s[np.array([r["status"] != "open" for r in rows])]
+        if touching.size and touching.max() > touching.min():
+            margin = 0.2 * (touching.max() - touching.min())
+            top.set_xlim(touching.min() - margin, touching.max() + margin)
+        for a in (top, bottom):
+            a.grid(True, alpha=0.3)
+            a.legend(loc="best")
+    save(figure, os.path.join(folder, "contact_friction.png"))
+
+
 def main():
     if len(sys.argv) != 2:
         sys.exit("usage: plot_results.py FOLDER")
@@ -126,6 +172,7 @@ def main():
     deformation(folder, summary, material, vertex)
     stress_yy(folder, material, vertex)
     contact_pressure(folder)
+    contact_friction(folder)
 
 
 if __name__ == "__main__":

@@ -25,7 +25,9 @@ namespace knee_contact
       "The load parameter t of each load case, separated by ','; an entry "
       "'first:step:last' stands for first, first+step, ..., last. Traction, "
       "pressure and body force expressions (and exact solutions) may use t; "
-      "displacement conditions may not. Empty: one case at t = 0.",
+      "displacement conditions may not. Empty: one case at t = 0. With "
+      "friction the cases are a load path: each starts where the previous "
+      "ended and the slip accumulates (the first from the unloaded state).",
       Patterns::List(
         Patterns::Anything(), 0, Patterns::List::max_int_value, ","));
     prm.leave_subsection();

@@ -115,7 +115,15 @@ namespace knee_contact
       entries.interface_forces,
       "Expected magnitude of the contact force on each interface's slave "
       "body [N/m]: 'interface name: constant expression; ...', e.g. the load "
-      "a body held only by that interface carries.",
+      "a body held only by that interface carries (with friction the normal "
+      "and tangential forces together).",
+      input::named_list_pattern(Patterns::Anything()));
+    prm.add_parameter(
+      "Reference tangential forces",
+      entries.tangential_forces,
+      "Expected magnitude of the friction force on each interface's slave "
+      "body [N/m], as Reference contact forces, e.g. mu times the normal "
+      "force where the whole interface slips.",
       input::named_list_pattern(Patterns::Anything()));
     prm.add_parameter("Contact force tolerance",
                       force_tolerance,
@@ -161,6 +169,11 @@ namespace knee_contact
         name,
         input::evaluate_constant(value,
                                  "Verification/Reference contact forces"));
+    for (const auto &[name, value] : entries.tangential_forces)
+      tangential_forces.emplace_back(
+        name,
+        input::evaluate_constant(value,
+                                 "Verification/Reference tangential forces"));
     AssertThrow(entries.extreme_stress.size() <= 1,
                 ExcMessage("Verification/Reference extreme stress_yy: "
                            "give one material, not several"));
@@ -499,22 +512,40 @@ namespace knee_contact
              last.stress_extreme_relative,
              "<=",
              extreme_stress_tolerance);
-    for (const auto &[name, force] : interface_forces)
-      {
-        const auto it = std::find_if(results.interfaces.begin(),
-                                     results.interfaces.end(),
-                                     [&](const InterfaceResult<dim> &i) {
-                                       return i.name == name;
-                                     });
-        AssertThrow(it != results.interfaces.end(),
-                    ExcMessage("Verification/Reference contact forces: no "
-                               "contact interface named '" +
-                               name + "'"));
-        report("relative error of the contact force on '" + name + "'",
-               std::abs(it->force_on_slave.norm() - force) / force,
-               "<=",
-               force_tolerance);
-      }
+    const auto check_forces =
+      [&](const std::vector<std::pair<std::string, double>> &forces,
+          const std::string                                  &parameter,
+          const std::string                                  &what,
+          const bool                                          tangential) {
+        for (const auto &[name, force] : forces)
+          {
+            const auto it = std::find_if(results.interfaces.begin(),
+                                         results.interfaces.end(),
+                                         [&](const InterfaceResult<dim> &i) {
+                                           return i.name == name;
+                                         });
+            AssertThrow(it != results.interfaces.end(),
+                        ExcMessage("Verification/" + parameter +
+                                   ": no contact interface named '" + name +
+                                   "'"));
+            const Tensor<1, dim> value =
+              tangential ? it->tangential_force_on_slave :
+                           Tensor<1, dim>(it->force_on_slave +
+                                          it->tangential_force_on_slave);
+            report("relative error of the " + what + " on '" + name + "'",
+                   std::abs(value.norm() - force) / force,
+                   "<=",
+                   force_tolerance);
+          }
+      };
+    check_forces(interface_forces,
+                 "Reference contact forces",
+                 "contact force",
+                 false);
+    check_forces(tangential_forces,
+                 "Reference tangential forces",
+                 "tangential force",
+                 true);
     return n_failed;
   }
 

@@ -18,8 +18,17 @@
    interface force (normal plus tangential on the slave) balances the
    load to 1e-8 relative (node-to-node, node-to-segment and mortar); with
    mu = 0.1 < r the run is refused in one line naming the ratio 0.2.
+4. The NAFEMS CGS-4 threshold on an inclined interface: the block on a
+   base both tilted by a = 20 degrees (non-matching meshes), mu = 0.3,
+   pushed by a horizontal force F and a vertical G (a traction on its top
+   side): it stays iff F/G <= (tan a + mu) / (1 - mu tan a) = 0.7454. At
+   0.97 times the threshold the interface force balances the load to 1e-8
+   (node-to-segment and mortar); at 1.03 times the run is refused in one
+   line naming the ratio the block needs along the tilted interface,
+   (F cos a - G sin a) / (F sin a + G cos a) = 0.316, to 3 digits.
 Usage: friction.py KNEE_CONTACT
 """
+import math
 import json
 import os
 import re
@@ -89,6 +98,78 @@ INTERFACE = """  subsection Interface 0
     set Friction             = coulomb
     set Friction coefficient = {mu}
   end"""
+
+
+# A block (1 x 0.25, 8 x 2 cells) on a base (3 x 1, 13 x 4), both turned
+# by {angle} degrees about the origin; curves: 1 base bottom, 3 base top,
+# 5 block bottom, 6 block top.
+INCLINED_GEO = """
+Geometry.AutoCoherence = 0;
+Point(1) = {{-1.5, -1, 0}}; Point(2) = {{1.5, -1, 0}};
+Point(3) = {{1.5, 0, 0}}; Point(4) = {{-1.5, 0, 0}};
+Point(5) = {{-0.5, 0, 0}}; Point(6) = {{0.5, 0, 0}};
+Point(7) = {{0.5, 0.25, 0}}; Point(8) = {{-0.5, 0.25, 0}};
+Line(1) = {{1, 2}}; Line(2) = {{2, 3}}; Line(3) = {{3, 4}}; Line(4) = {{4, 1}};
+Line(5) = {{5, 6}}; Line(6) = {{6, 7}}; Line(7) = {{7, 8}}; Line(8) = {{8, 5}};
+Curve Loop(1) = {{1, 2, 3, 4}}; Plane Surface(1) = {{1}};
+Curve Loop(2) = {{5, 6, 7, 8}}; Plane Surface(2) = {{2}};
+Transfinite Curve{{1, 3}} = 14; Transfinite Curve{{2, 4}} = 5;
+Transfinite Curve{{5, 7}} = 9; Transfinite Curve{{6, 8}} = 3;
+Transfinite Surface{{1, 2}}; Recombine Surface{{1, 2}};
+Rotate {{{{0, 0, 1}}, {{0, 0, 0}}, {angle} * Pi / 180}} {{ Surface{{1, 2}}; }}
+Physical Surface(1) = {{1}}; Physical Surface(2) = {{2}};
+Physical Curve(1) = {{1}}; Physical Curve(3) = {{3}};
+Physical Curve(5) = {{5}}; Physical Curve(6) = {{7}};
+"""
+
+INCLINED = """
+subsection Mesh
+  set Source = file
+  set File   = {geo}
+end
+subsection Materials
+  set Number of materials = 2
+  subsection Material 0
+    set Material id     = 1
+    set Name            = base
+    set Young's modulus = 1e9
+    set Poisson's ratio = 0.3
+  end
+  subsection Material 1
+    set Material id     = 2
+    set Name            = block
+    set Young's modulus = 3e9
+    set Poisson's ratio = 0.2
+  end
+end
+subsection Boundary conditions
+  set Number of conditions = 2
+  subsection Condition 0
+    set Boundary ids = 1
+    set Type         = displacement
+  end
+  subsection Condition 1
+    set Boundary ids = 6
+    set Type         = traction
+    set Value        = {fx}; {fy}
+  end
+end
+subsection Contact
+  set Number of interfaces = 1
+  subsection Interface 0
+    set Name                 = block
+    set Slave boundary id    = 5
+    set Master boundary id   = 3
+    set Pairing              = {pairing}
+    set Friction             = coulomb
+    set Friction coefficient = {mu}
+  end
+end
+subsection Output
+  set Folder   = {folder}
+  set Pictures = false
+end
+"""
 
 
 def run(binary, text, folder, name, expect_success=True):
@@ -241,6 +322,49 @@ def main():
             print("%s, mu = 0.1 < 0.2: exit %d, %s" %
                   (pairing, refused.returncode, lines[-1] if lines else ""))
             failures += not ok
+
+        # 4. NAFEMS CGS-4: the threshold on an inclined interface.
+        angle, mu, G = 20.0, 0.3, 1e6
+        a = math.radians(angle)
+        threshold = (math.tan(a) + mu) / (1 - mu * math.tan(a))
+        geo = os.path.join(folder, "inclined.geo")
+        with open(geo, "w") as f:
+            f.write(INCLINED_GEO.format(angle=angle))
+        for pairing in ("node-to-segment", "mortar"):
+            for factor in (0.97, 1.03):
+                F = factor * threshold * G
+                name = "inclined_%s_%g" % (pairing, factor)
+                # The traction on the top side (length 1): force (F, -G).
+                text = INCLINED.format(geo=geo, fx=F, fy=-G, pairing=pairing,
+                                       mu=mu,
+                                       folder=os.path.join(folder, name))
+                if factor < 1:
+                    summary = run(binary, text, folder, name)
+                    interface = summary["contact_interfaces"]["block"]
+                    total = [interface["force_on_slave"][d] +
+                             interface["tangential_force_on_slave"][d] +
+                             (F, -G)[d] for d in range(2)]
+                    error = max(abs(x) for x in total) / G
+                    print("CGS-4 %s, F/G = %.4f (threshold %.4f): interface "
+                          "force + load relative %.1e (tolerance 1e-8); %d "
+                          "sticking, %d slipping" %
+                          (pairing, F / G, threshold, error,
+                           interface["n_stick"], interface["n_slip"]))
+                    failures += error > 1e-8
+                else:
+                    ratio = (F * math.cos(a) - G * math.sin(a)) / (
+                        F * math.sin(a) + G * math.cos(a))
+                    refused = run(binary, text, folder, name,
+                                  expect_success=False)
+                    lines = refused.stderr.strip().splitlines()
+                    ok = (refused.returncode == 1 and len(lines) == 1 and
+                          "friction cannot hold it" in lines[0] and
+                          "tangential/normal force %.3g)" % ratio in lines[0])
+                    print("CGS-4 %s, F/G = %.4f > %.4f: exit %d, needs %.3g: "
+                          "%s" % (pairing, F / G, threshold,
+                                  refused.returncode, ratio,
+                                  lines[-1] if lines else ""))
+                    failures += not ok
     if failures:
         raise SystemExit("%d failures" % failures)
 

@@ -5,6 +5,7 @@ For every scene given, each physical input is perturbed by 1 %, one at a
 time, in a copy of the scene:
   E        every material's Young's modulus        x 1.01
   nu       every material's Poisson's ratio        x 1.01
+  mu       every interface's Friction coefficient and Tresca bound x 1.01
   load     every non-zero condition value and body force x 1.01
   geometry every coordinate x 1.01 (Rectangles; a .geo gets
            Mesh.ScalingFactor = 1.01; circle centres scaled too)
@@ -40,6 +41,10 @@ EXEMPT = [
     ("large_gap.prm", r"^(E|nu|geometry):",
      "the gap stays open and the lifted body moves rigidly: u does not "
      "depend on E, nu or the size of the blocks"),
+    ("friction_sliding_block.prm", r"^(E|nu):|Condition 2: displacement",
+     "the whole interface slips: statics fix the normal force G L and the "
+     "friction force mu G L for any E and nu and any push that makes every "
+     "pair slip"),
     ("uniaxial_block.prm", r"^geometry:",
      "homogeneous strain under a traction: u = eps x holds on a block of "
      "any size, so scaling the block cannot change the answer"),
@@ -169,6 +174,11 @@ def mutants(scene_path):
             yield ("nu", f"{path}: nu x {factor}",
                    replace_entry(text, start, end, name,
                                  repr(float(value) * factor)), {})
+        elif name in ("Friction coefficient", "Tresca bound") and \
+                not is_zero(value):
+            yield ("mu", f"{path}: {name} x {FACTOR}",
+                   replace_entry(text, start, end, name, scale_number(value)),
+                   {})
         elif name == "Body force" and not is_zero(value):
             yield ("load", f"{path}: body force x {FACTOR}",
                    replace_entry(text, start, end, name,

@@ -122,6 +122,7 @@ namespace knee_contact
       std::string peak_pressure, contact_length, reference_energy;
       std::vector<std::pair<std::string, std::string>> extreme_stress;
       std::vector<std::pair<std::string, std::string>> interface_forces;
+      std::vector<std::pair<std::string, std::string>> tangential_forces;
     } entries;
 
     std::unique_ptr<FunctionParser<dim>>        exact_displacement;
@@ -143,6 +144,7 @@ namespace knee_contact
     std::string                                 extreme_stress_material;
     double                                      extreme_stress = 0;
     std::vector<std::pair<std::string, double>> interface_forces;
+    std::vector<std::pair<std::string, double>> tangential_forces;
     double                                      force_tolerance = 1e-8;
   };
 } // namespace knee_contact
