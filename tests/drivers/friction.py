@@ -26,10 +26,21 @@
    (node-to-segment and mortar); at 1.03 times the run is refused in one
    line naming the ratio the block needs along the tilted interface,
    (F cos a - G sin a) / (F sin a + G cos a) = 0.316, to 3 digits.
+5. Tresca on a strip: an elastic strip (1 x 0.01, 100 x 2 cells, E = 1e9,
+   nu = 0, plane stress) pressed (1e6 Pa) onto a base 1e4 times stiffer
+   and pulled at its right end by F = 4e4 N/m, slip bound g = 1e5 Pa. Bar
+   theory: the strip slips over the length l = F/g = 0.4 from the pulled
+   end and sticks beyond; the end moves by g l^2 / (2 E h) = 8e-4 m.
+   Asserted: the stick/slip boundary (midway between the last sticking and
+   the first slipping vertex) to the strip's height h (measured 0.5 h; the
+   2D strip's shear lag, 0.75 h at h = 0.02, 0.5 h at h = 0.005) and the
+   end's displacement to 1 % (measured 0.1 %; 0.5 % at h = 0.02, 0.03 %
+   at h = 0.005).
 Usage: friction.py KNEE_CONTACT
 """
-import math
+import csv
 import json
+import math
 import os
 import re
 import subprocess
@@ -163,6 +174,63 @@ subsection Contact
     set Pairing              = {pairing}
     set Friction             = coulomb
     set Friction coefficient = {mu}
+  end
+end
+subsection Output
+  set Folder   = {folder}
+  set Pictures = false
+end
+"""
+
+
+STRIP = """
+subsection Mesh
+  set Source     = rectangles
+  set Rectangles = 0, -0.1, 1.2, 0, 60, 5, 1, 0, 7, 8, 1, 2; \\
+                   0, 0, 1, 0.01, 100, 2, 2, 1, 5, 9, 4, 6
+end
+subsection Materials
+  set Number of materials = 2
+  set Plane               = stress
+  subsection Material 0
+    set Material id     = 1
+    set Name            = base
+    set Young's modulus = 1e13
+    set Poisson's ratio = 0
+  end
+  subsection Material 1
+    set Material id     = 2
+    set Name            = strip
+    set Young's modulus = 1e9
+    set Poisson's ratio = 0
+  end
+end
+subsection Boundary conditions
+  set Number of conditions = 3
+  subsection Condition 0
+    set Boundary ids = 1
+    set Type         = displacement
+  end
+  subsection Condition 1
+    set Boundary ids = 6
+    set Type         = pressure
+    set Value        = 1e6
+  end
+  subsection Condition 2
+    set Boundary ids = 9
+    set Type         = traction
+    set Value        = 4e6; 0
+  end
+end
+subsection Contact
+  set Number of interfaces = 1
+  subsection Interface 0
+    set Name               = strip
+    set Slave boundary id  = 4
+    set Master boundary id = 2
+    set Pairing            = node-to-segment
+    set Friction           = tresca
+    set Tresca bound       = 1e5
   end
 end
 subsection Output
@@ -365,6 +433,27 @@ def main():
                                   refused.returncode, ratio,
                                   lines[-1] if lines else ""))
                     failures += not ok
+
+        # 5. Tresca: the slip zone of a strip pulled at one end.
+        strip = os.path.join(folder, "strip")
+        summary = run(binary, STRIP.format(folder=strip), folder, "strip")
+        with open(os.path.join(strip, "contact_strip.csv")) as f:
+            rows = list(csv.DictReader(f))
+        stick = [float(r["x"]) for r in rows if r["status"] == "stick"]
+        slip = [float(r["x"]) for r in rows if r["status"] == "slip"]
+        h, g, F, E = 0.01, 1e5, 4e4, 1e9
+        boundary = (max(stick) + min(slip)) / 2
+        error = abs(boundary - (1 - F / g)) / h
+        print("Tresca strip: stick/slip boundary at x = %.4f, analytic %.4f: "
+              "%.2f strip heights (tolerance 1)" % (boundary, 1 - F / g,
+                                                    error))
+        failures += error > 1 or min(slip) < max(stick)
+        end = g * (F / g) ** 2 / (2 * E * h)
+        error = abs(summary["max_displacement"] - end) / end
+        print("Tresca strip: end displacement %.5e, bar theory %.5e: "
+              "relative %.1e (tolerance 1e-2)" %
+              (summary["max_displacement"], end, error))
+        failures += error > 1e-2
     if failures:
         raise SystemExit("%d failures" % failures)
 
