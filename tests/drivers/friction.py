@@ -58,13 +58,7 @@ FRICTIONLESS = [("contact_patch_matching.prm", 1e-12),
                 ("contact_patch_mixed.prm", 1e-12), ("hertz_small.prm", 1e-12),
                 ("knee_small.prm", 1e-10)]
 
-BLOCK = """
-subsection Mesh
-  set Source     = rectangles
-  set Rectangles = 0, 0, 1, 0.5, 8, 4, 1, 0, 1, 1, 2, 3; \\
-                   0.25, 0.5, 0.75, 0.75, 4, 2, 2, {group}, 4, 4, 5, 6
-end
-subsection Materials
+MATERIALS = """subsection Materials
   set Number of materials = 2
   subsection Material 0
     set Material id     = 1
@@ -79,7 +73,15 @@ subsection Materials
     set Poisson's ratio = 0.2
   end
 end
-subsection Boundary conditions
+"""
+
+BLOCK = """
+subsection Mesh
+  set Source     = rectangles
+  set Rectangles = 0, 0, 1, 0.5, 8, 4, 1, 0, 1, 1, 2, 3; \\
+                   0.25, 0.5, 0.75, 0.75, 4, 2, 2, {group}, 4, 4, 5, 6
+end
+{materials}subsection Boundary conditions
   set Number of conditions = 2
   subsection Condition 0
     set Boundary ids = 2
@@ -138,22 +140,7 @@ subsection Mesh
   set Source = file
   set File   = {geo}
 end
-subsection Materials
-  set Number of materials = 2
-  subsection Material 0
-    set Material id     = 1
-    set Name            = base
-    set Young's modulus = 1e9
-    set Poisson's ratio = 0.3
-  end
-  subsection Material 1
-    set Material id     = 2
-    set Name            = block
-    set Young's modulus = 3e9
-    set Poisson's ratio = 0.2
-  end
-end
-subsection Boundary conditions
+{materials}subsection Boundary conditions
   set Number of conditions = 2
   subsection Condition 0
     set Boundary ids = 1
@@ -167,14 +154,7 @@ subsection Boundary conditions
 end
 subsection Contact
   set Number of interfaces = 1
-  subsection Interface 0
-    set Name                 = block
-    set Slave boundary id    = 5
-    set Master boundary id   = 3
-    set Pairing              = {pairing}
-    set Friction             = coulomb
-    set Friction coefficient = {mu}
-  end
+{interface}
 end
 subsection Output
   set Folder   = {folder}
@@ -339,10 +319,10 @@ def main():
 
         # 2. Very large mu against bonded rectangles.
         bonded = run(binary, BLOCK.format(
-            group=0, n_interfaces=0, interface="",
+            materials=MATERIALS, group=0, n_interfaces=0, interface="",
             folder=os.path.join(folder, "bonded")), folder, "bonded")
         sticking = run(binary, BLOCK.format(
-            group=1, n_interfaces=1,
+            materials=MATERIALS, group=1, n_interfaces=1,
             interface=INTERFACE.format(pairing="node-to-node", mu=1e3),
             folder=os.path.join(folder, "sticking")), folder, "sticking")
         assert sticking["contact_interfaces"]["block"]["n_slip"] == 0
@@ -366,7 +346,7 @@ def main():
         for pairing in ("node-to-node", "node-to-segment", "mortar"):
             name = "statics_" + pairing
             summary = run(binary, BLOCK.format(
-                group=1, n_interfaces=1,
+                materials=MATERIALS, group=1, n_interfaces=1,
                 interface=INTERFACE.format(pairing=pairing, mu=0.5),
                 folder=os.path.join(folder, name)), folder, name)
             interface = summary["contact_interfaces"]["block"]
@@ -379,7 +359,7 @@ def main():
                   % (pairing, total, error, interface["n_stick"]))
             failures += error > 1e-8
             refused = run(binary, BLOCK.format(
-                group=1, n_interfaces=1,
+                materials=MATERIALS, group=1, n_interfaces=1,
                 interface=INTERFACE.format(pairing=pairing, mu=0.1),
                 folder=os.path.join(folder, name + "_slides")), folder,
                 name + "_slides", expect_success=False)
@@ -403,9 +383,10 @@ def main():
                 F = factor * threshold * G
                 name = "inclined_%s_%g" % (pairing, factor)
                 # The traction on the top side (length 1): force (F, -G).
-                text = INCLINED.format(geo=geo, fx=F, fy=-G, pairing=pairing,
-                                       mu=mu,
-                                       folder=os.path.join(folder, name))
+                text = INCLINED.format(
+                    geo=geo, fx=F, fy=-G, materials=MATERIALS,
+                    interface=INTERFACE.format(pairing=pairing, mu=mu),
+                    folder=os.path.join(folder, name))
                 if factor < 1:
                     summary = run(binary, text, folder, name)
                     interface = summary["contact_interfaces"]["block"]
