@@ -155,7 +155,8 @@ namespace knee_contact
     // stick, 2 slip) in one vector, this case's and the accumulated slip in
     // another.
     Vector<double> traction_field, slip_field;
-    if (!contact.status.empty())
+    if (contact.status.size() == pairs.size() &&
+        contact.accumulated_slip.size() == pairs.size())
       {
         traction_field.reinit(dof_handler.n_dofs());
         slip_field.reinit(dof_handler.n_dofs());
@@ -328,14 +329,17 @@ namespace knee_contact
         write_file(name, [&](std::ostream &out) {
           // The discretisation in every row, so that a CSV read on its
           // own says how its pressure was computed.
-          // With friction: the tangential traction lambda_t / length
-          // along t = (-n_y, n_x) [Pa], this case's slip t . (u_slave -
-          // u_master) increment [m], the slip accumulated along the load
-          // path [m] and the status.
-          const bool friction = !contact.status.empty();
+          // With friction: the tangent t of the tangential row (the
+          // common normal's, ContactPoint::tangent), the tangential
+          // traction lambda_t / length along t [Pa] (the force on the slave
+          // is -lambda_t t), this case's slip t . (u_slave - u_master)
+          // increment [m], the slip accumulated along the load path [m]
+          // and the status.
+          const bool friction = contact.status.size() == pairs.size() &&
+                                contact.accumulated_slip.size() == pairs.size();
           out << "arc_length,x,y,n_x,n_y,gap,jump,pressure,active,"
-              << (friction ? "tangential_traction,slip,accumulated_slip,"
-                             "status,"
+              << (friction ? "t_x,t_y,tangential_traction,slip,"
+                             "accumulated_slip,status,"
                            : "")
               << "discretisation\n"
               << std::setprecision(10);
@@ -353,7 +357,8 @@ namespace knee_contact
                   << results.pressure[order[k]] << ','
                   << (contact.active[order[k]] ? 1 : 0) << ',';
               if (friction)
-                out << contact.lambda_t[order[k]] / row.length << ','
+                out << point.tangent[0] << ',' << point.tangent[1] << ','
+                    << contact.lambda_t[order[k]] / row.length << ','
                     << contact.slip[order[k]] << ','
                     << contact.accumulated_slip[order[k]] << ','
                     << status_name(contact.status[order[k]]) << ',';

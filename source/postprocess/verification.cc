@@ -174,6 +174,16 @@ namespace knee_contact
         name,
         input::evaluate_constant(value,
                                  "Verification/Reference tangential forces"));
+    // Their relative errors are checked: a reference must be positive.
+    for (const auto &[forces, parameter] :
+         {std::make_pair(&interface_forces, "Reference contact forces"),
+          std::make_pair(&tangential_forces, "Reference tangential forces")})
+      for (const auto &[name, force] : *forces)
+        AssertThrow(force > 0,
+                    ExcMessage("Verification/" + std::string(parameter) +
+                               ": the force of '" + name +
+                               "' must be positive (its relative error is "
+                               "checked)"));
     AssertThrow(entries.extreme_stress.size() <= 1,
                 ExcMessage("Verification/Reference extreme stress_yy: "
                            "give one material, not several"));
@@ -514,9 +524,9 @@ namespace knee_contact
              extreme_stress_tolerance);
     const auto check_forces =
       [&](const std::vector<std::pair<std::string, double>> &forces,
-          const std::string                                  &parameter,
-          const std::string                                  &what,
-          const bool                                          tangential) {
+          const std::string                                 &parameter,
+          const std::string                                 &what,
+          const bool                                         tangential) {
         for (const auto &[name, force] : forces)
           {
             const auto it = std::find_if(results.interfaces.begin(),
@@ -529,8 +539,8 @@ namespace knee_contact
                                    ": no contact interface named '" + name +
                                    "'"));
             const Tensor<1, dim> value =
-              tangential ? it->tangential_force_on_slave :
-                           Tensor<1, dim>(it->force_on_slave +
+              tangential ? it->tangential_force_on_slave
+                         : Tensor<1, dim>(it->force_on_slave +
                                           it->tangential_force_on_slave);
             report("relative error of the " + what + " on '" + name + "'",
                    std::abs(value.norm() - force) / force,

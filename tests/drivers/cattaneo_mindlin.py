@@ -166,9 +166,10 @@ def traction_error(rows, reference, width, p0, h, kinks=()):
     """Largest |q - reference(x)| / (mu p0) over |x| < width - h except within
     h of the kinks (the vertex next to a stick zone's end, which lies
     between vertices, carries the kink of q: 11 % there, measured); q is the
-    CSV's tangential traction lambda_t / length along t = (-n_y, n_x),
-    which is +x at the bottom of the disc; the force on the slave is
-    -lambda_t t, so a positive q resists a load along +x."""
+    CSV's tangential traction lambda_t / length along the pair's tangent
+    t (the CSV's t_x, t_y: +x here, the common tangent of the two equal
+    discs); the force on the slave is -lambda_t t, so a positive q resists
+    a load along +x."""
     worst = 0.0
     for r in rows:
         x = float(r["x"])
