@@ -147,12 +147,8 @@ namespace knee_contact
         // systems keep what depends on the gaps (a factorisation under
         // inhomogeneous constraints), so the system is made anew.
         const bool path_step = !new_matrix && !contact_pairs.tangential.empty();
-        std::vector<double> accumulated(contact_pairs.size(), 0.);
         if (path_step)
-          {
-            hold_tangential_rows_at(displacement);
-            accumulated = contact_solution.accumulated_slip;
-          }
+          hold_tangential_rows_at(displacement);
         if (new_matrix || path_step)
           {
             solver_figures.clear();
@@ -180,6 +176,10 @@ namespace knee_contact
           }
         else
           {
+            std::vector<double> accumulated =
+              path_step ? contact_solution.accumulated_slip
+                        : std::vector<double>(contact_pairs.size(), 0.);
+            accumulated.resize(contact_pairs.size(), 0.);
             std::vector<FrictionBound> bounds(contact_pairs.size());
             for (unsigned int p = 0; p < contact_pairs.size(); ++p)
               {

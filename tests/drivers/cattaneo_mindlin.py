@@ -61,11 +61,13 @@ import csv
 import json
 import math
 import os
-import subprocess
 import sys
 import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+from friction import run_scene  # noqa: E402
+
 GEO = os.path.normpath(os.path.join(HERE, "..", "meshes", "cattaneo.geo"))
 E, NU, MU, R = 1.0, 0.3, 0.3, 1.0
 E_STAR = E / (2 * (1 - NU**2))
@@ -128,17 +130,13 @@ end
 
 
 def run(binary, folder, name, lc, d, fx, t, pairing="mortar", lower=True):
+    """The scene with these values run in folder/name; that folder."""
     out = os.path.join(folder, name)
-    scene = out + ".prm"
-    with open(scene, "w") as f:
-        f.write(SCENE.format(geo=GEO, lc=lc, E=E, nu=NU, fx=fx, d=d, mu=MU,
-                             fx_lower=fx if lower else 0,
-                             t=t, pairing=pairing, folder=out))
-    result = subprocess.run([binary, scene], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
-    if result.returncode != 0:
-        print(result.stdout[-3000:], result.stderr)
-        raise SystemExit("%s: exit code %d" % (name, result.returncode))
+    run_scene(binary,
+              SCENE.format(geo=GEO, lc=lc, E=E, nu=NU, fx=fx, d=d, mu=MU,
+                           fx_lower=fx if lower else 0, t=t, pairing=pairing,
+                           folder=out),
+              folder, name)
     return out
 
 

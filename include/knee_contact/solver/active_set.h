@@ -40,9 +40,10 @@ namespace knee_contact
 
     /**
      * With friction (solve_with_friction()), per pair: the tangential
-     * multiplier [N/m] (the force t . tau on the slave), the tangential
-     * jump t . (u_slave - u_master) [m] (the slip of a slipping pair), and
-     * the status. Empty without friction.
+     * multiplier [N/m] (the force on the slave is -lambda_t t, t the
+     * pair's tangent), the slip t . (u_slave - u_master) less the
+     * tangential row's gap [m] of a slipping pair (zero where it sticks or
+     * is open), and the status. Empty without friction.
      */
     std::vector<double> lambda_t;
     std::vector<double> slip;
