@@ -506,6 +506,7 @@ namespace knee_contact
             if (friction)
               {
                 choose(slide);
+                slide.measured_only = true;
                 tangential.push_back(std::move(slide));
                 // Never active together with the pair's N or T rows: they
                 // may eliminate the same dofs.

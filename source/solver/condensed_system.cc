@@ -219,9 +219,13 @@ namespace knee_contact
     // iteration solves a P x P system (P = number of pairs, a fraction of
     // k), and each load case costs two triangular solves with S~.
     const std::size_t k = dofs.size();
+    // Rows that are only measured (the tangential rows with friction) stay
+    // out: they are never active, and each row here adds to the P x P
+    // system of every iteration.
     row_pairs.clear();
     for (unsigned int p = 0; p < pairs.size(); ++p)
-      if (pairs[p].eliminated != numbers::invalid_dof_index)
+      if (pairs[p].eliminated != numbers::invalid_dof_index &&
+          !pairs[p].measured_only)
         row_pairs.push_back(p);
     const std::size_t n_rows = row_pairs.size();
     if (k == 0 || n_rows == 0)

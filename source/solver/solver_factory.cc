@@ -152,12 +152,17 @@ namespace knee_contact
 
     // Sizes of the condensed path: k contact unknowns (every free dof of
     // a row that can be active), P rows.
+    // The rows only measured (friction's tangential rows) are not in the
+    // condensed path's per-iteration system.
     std::set<types::global_dof_index> contact;
-    double                            n_rows = 0;
+    double                            n_rows   = 0;
+    bool                              friction = false;
     for (const auto &pair : pairs)
       if (pair.eliminated != numbers::invalid_dof_index)
         {
-          ++n_rows;
+          friction = friction || pair.measured_only;
+          if (!pair.measured_only)
+            ++n_rows;
           for (const auto &entry : pair.reduced_row)
             contact.insert(entry.first);
         }
@@ -176,7 +181,11 @@ namespace knee_contact
     // Iterations the loop is expected to take: measured 1-5 from a guess
     // (a refined mesh's or load case's contact zone), up to 17 cold
     // (scripts/benchmark.py); each costs the condensed path one P x P LU.
-    const double iterations = warm_start ? 3 : 10;
+    // With friction the stick and slip sets and the Coulomb bounds settle
+    // too: measured 9-17 cold on the sagittal knee (mu = 0.04 and 0.3),
+    // 4-9 along a load path.
+    const double iterations =
+      friction ? (warm_start ? 7 : 15) : (warm_start ? 3 : 10);
 
     // Peak memory beyond what is allocated now [bytes]: the factor's values
     // and indices (about 1.2 x 8 bytes per entry measured), CHOLMOD's copy of
@@ -196,15 +205,24 @@ namespace knee_contact
     // Dense BLAS-3 runs about 4x the flop rate of a supernodal factorisation
     // of a 2D mesh on this machine kind (measured: potrf/syrk at k = 5 000
     // 15-20 Gflop/s, CHOLMOD 2-5 Gflop/s), so dense flops count a quarter.
+    // The per-iteration LU (getrf) runs faster still: measured 61 Gflop/s
+    // at P = 1 734 against CHOLMOD's 3.9 Gflop/s on the same knee mesh
+    // (1.35e5 dofs, AMD EPYC, 2026-11-24), so its flops count an eighth.
     const double condensed_flops =
-      fl + 0.25 * (k * k * k * (1. / 3 + 1 + 1. / 3) + 2 * k * k * P +
-                   iterations * 2. / 3 * P * P * P);
+      fl + 0.25 * (k * k * k * (1. / 3 + 1 + 1. / 3) + 2 * k * k * P) +
+      0.125 * iterations * 2. / 3 * P * P * P;
     // The sparse path refactorises only when an active set differs from its
     // factor's in more rows than a factorisation's worth of solves: from a
     // guess one factorisation and a few solves (measured 1.1-1.3
     // factorisations), cold about two per three iterations (knee, 1.1e5
     // dofs: 9 factorisations and 31 update solves in 14 iterations).
-    const double sparse_flops = (warm_start ? 1.3 : 0.65 * iterations) * fl;
+    // With friction about one per two iterations (knee, 1.35e5 dofs, mu =
+    // 0.04: 6 factorisations and 7 bordered updates, 20 update solves, in
+    // 13 iterations).
+    const double sparse_flops = (friction     ? 0.5 * iterations
+                                 : warm_start ? 1.3
+                                              : 0.65 * iterations) *
+                                fl;
 
     std::string  limit;
     const double available = available_memory(limit);

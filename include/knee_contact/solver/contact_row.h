@@ -48,6 +48,13 @@ namespace knee_contact
      */
     types::global_dof_index eliminated       = numbers::invalid_dof_index;
     bool                    slave_eliminated = true;
+    /**
+     * A row the loop only measures and never holds as an equality (the
+     * tangential row of a frictional pair: its slip; a sticking pair is
+     * held by its stick_x and stick_y rows). The condensed path leaves it
+     * out of its per-iteration system, and the solver choice counts it.
+     */
+    bool measured_only = false;
 
     /**
      * The slave vertex's spacing [m] in a mesh of dimension @p dim: the
