@@ -143,13 +143,15 @@ namespace knee_contact
         // Along a load path with friction (a further case on the same
         // matrix) each case starts where the previous one ended: a pair
         // sticks where it is, so the tangential rows' gaps become the
-        // current tangential jumps, and the slip accumulates. The contact
-        // systems keep what depends on the gaps (a factorisation under
-        // inhomogeneous constraints), so the system is made anew.
+        // current tangential jumps, and the slip accumulates. The
+        // factorised system stays; it is told that the gaps changed.
         const bool path_step = !new_matrix && !contact_pairs.tangential.empty();
         if (path_step)
-          hold_tangential_rows_at(displacement);
-        if (new_matrix || path_step)
+          {
+            hold_tangential_rows_at(displacement);
+            contact_system->gaps_changed();
+          }
+        if (new_matrix)
           {
             solver_figures.clear();
             contact_system.reset();

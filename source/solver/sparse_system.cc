@@ -279,6 +279,20 @@ namespace knee_contact
 
 
   void
+  SparseContactSystem::gaps_changed()
+  {
+    Implementation &d = *implementation;
+    if (d.has_factor)
+      ActiveSetSolver::make_constraints(d.base,
+                                        d.pairs,
+                                        d.base_active,
+                                        d.constraints);
+    d.base_solved = false;
+  }
+
+
+
+  void
   SparseContactSystem::solve(const std::vector<bool> &active,
                              std::vector<double>     &excess,
                              std::vector<double>     &lambda)

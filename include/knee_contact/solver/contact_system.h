@@ -56,6 +56,17 @@ namespace knee_contact
           std::vector<double>     &lambda) = 0;
 
     /**
+     * The gaps g_p of the rows (not their coefficients) have changed since
+     * the last solve, as along a load path with friction (a sticking pair
+     * is held where it is): the next solve uses the new gaps, on the same
+     * factorisation. The default suits a path that reads the gaps at every
+     * solve.
+     */
+    virtual void
+    gaps_changed()
+    {}
+
+    /**
      * max |x_i| of the last solve over the contact unknowns (the free dofs
      * of the contact rows): the scale of the complementarity residual.
      */
@@ -243,6 +254,14 @@ namespace knee_contact
     solve(const std::vector<bool> &active,
           std::vector<double>     &excess,
           std::vector<double>     &lambda) override;
+
+    /**
+     * The factor stays (the gaps enter only the constraints'
+     * inhomogeneities, not the condensed matrix); the base solution is
+     * made anew.
+     */
+    void
+    gaps_changed() override;
 
     double
     displacement_scale() const override;
