@@ -3,7 +3,10 @@
 FOLDER/load_cases.csv:
   load_cases.png   against the load parameter t: peak contact pressure and
                    contact length of every interface, the applied load and
-                   the reaction of every Gamma_u/Gamma_o boundary id.
+                   the reaction of every Gamma_u/Gamma_o boundary id; with
+                   friction also each interface's sticking length and its
+                   largest slip in the case and accumulated along the path
+                   (micromotion).
 Usage: plot_load_cases.py FOLDER
 """
 import csv
@@ -30,12 +33,28 @@ def main():
                         for c in columns if c.startswith("reaction_")},
                        key=lambda s: int(s))
 
-    figure, axes = plt.subplots(3, 1, figsize=(7, 9), sharex=True)
+    friction = [n for n in interfaces if n + "_max_slip" in columns]
+    figure, axes = plt.subplots(4 if friction else 3, 1,
+                                figsize=(7, 12 if friction else 9),
+                                sharex=True)
     for name in interfaces:
         axes[0].plot(t, [float(r[name + "_peak_pressure"]) / 1e6
                          for r in rows], "o-", ms=3, label=name)
-        axes[1].plot(t, [float(r[name + "_contact_length"]) * 1e3
-                         for r in rows], "o-", ms=3, label=name)
+        line, = axes[1].plot(t, [float(r[name + "_contact_length"]) * 1e3
+                                 for r in rows], "o-", ms=3, label=name)
+        if name in friction:
+            axes[1].plot(t, [float(r[name + "_stick_length"]) * 1e3
+                             for r in rows], "--", color=line.get_color(),
+                         label=name + ": sticking")
+    for name in friction:
+        line, = axes[3].plot(t, [float(r[name + "_max_slip"]) * 1e6
+                                 for r in rows], "o-", ms=3,
+                             label=name + ": largest slip in the case")
+        axes[3].plot(t, [float(r[name + "_max_accumulated_slip"]) * 1e6
+                         for r in rows], "--", color=line.get_color(),
+                     label=name + ": largest accumulated slip")
+    if friction:
+        axes[3].set_ylabel("slip [um]")
     axes[0].set_ylabel("peak contact pressure [MPa]")
     axes[1].set_ylabel("contact length [mm]")
     for component, style in (("y", "-"), ("x", "--")):
@@ -46,7 +65,7 @@ def main():
                              for r in rows], style, marker="o", ms=3,
                          label="reaction id %s %s" % (b, component))
     axes[2].set_ylabel("force [kN/m]")
-    axes[2].set_xlabel("load parameter t")
+    axes[-1].set_xlabel("load parameter t")
     for a in axes:
         a.grid(True, alpha=0.3)
         a.legend(fontsize=7)

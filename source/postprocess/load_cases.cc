@@ -100,8 +100,13 @@ namespace knee_contact
       for (unsigned int d = 0; d < dim; ++d)
         out << ",reaction_" << id << '_' << "xyz"[d];
     for (const auto &i : first.interfaces)
-      out << ',' << i.name << "_active_pairs," << i.name << "_force," << i.name
-          << "_peak_pressure," << i.name << "_contact_length";
+      {
+        out << ',' << i.name << "_active_pairs," << i.name << "_force,"
+            << i.name << "_peak_pressure," << i.name << "_contact_length";
+        if (i.friction)
+          out << ',' << i.name << "_stick_length," << i.name << "_slip_length,"
+              << i.name << "_max_slip," << i.name << "_max_accumulated_slip";
+      }
     out << '\n' << std::setprecision(12);
     for (unsigned int c = 0; c < records.size(); ++c)
       {
@@ -116,8 +121,13 @@ namespace knee_contact
           for (unsigned int d = 0; d < dim; ++d)
             out << ',' << reaction[d];
         for (const auto &i : results.interfaces)
-          out << ',' << i.n_active << ',' << i.force << ',' << i.max_pressure
-              << ',' << i.contact_length;
+          {
+            out << ',' << i.n_active << ',' << i.force << ',' << i.max_pressure
+                << ',' << i.contact_length;
+            if (i.friction)
+              out << ',' << i.stick_length << ',' << i.slip_length << ','
+                  << i.max_slip << ',' << i.max_accumulated_slip;
+          }
         out << '\n';
       }
   }

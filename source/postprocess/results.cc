@@ -165,8 +165,9 @@ namespace knee_contact
     results.interfaces.resize(interfaces.interfaces().size());
     for (unsigned int i = 0; i < results.interfaces.size(); ++i)
       {
-        results.interfaces[i].name    = interfaces.interfaces()[i].name;
-        results.interfaces[i].pairing = interfaces.interfaces()[i].pairing;
+        results.interfaces[i].name     = interfaces.interfaces()[i].name;
+        results.interfaces[i].pairing  = interfaces.interfaces()[i].pairing;
+        results.interfaces[i].friction = !contact.lambda_t.empty();
       }
     results.pressure.resize(pairs.size());
     for (unsigned int p = 0; p < pairs.size(); ++p)

@@ -38,11 +38,13 @@ namespace knee_contact
     /** Length of slave boundary in contact, sum of the active shares [m]. */
     double contact_length = 0;
     /**
-     * With friction: the tangential force on the slave body, -sum
-     * lambda_t,p t_p [N/m], the pairs that stick and slip and their
-     * shares of the slave side [m], the largest slip of this load case
-     * and the largest accumulated along the load path [m].
+     * With friction (on any interface: friction is true and the figures
+     * are those of every interface): the tangential force on the slave body,
+     * -sum lambda_t,p t_p [N/m], the pairs that stick and slip and their shares
+     * of the slave side [m], the largest slip of this load case and the largest
+     * accumulated along the load path [m].
      */
+    bool           friction = false;
     Tensor<1, dim> tangential_force_on_slave;
     unsigned int   n_stick              = 0;
     unsigned int   n_slip               = 0;
