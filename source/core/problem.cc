@@ -334,6 +334,27 @@ namespace knee_contact
   ContactProblem<dim>::run()
   {
     TimerOutput timer(log(), TimerOutput::never, TimerOutput::wall_times);
+    if (refinement.target_error > 0)
+      {
+        // The names cycle_quantities() gives a contact quantity.
+        std::vector<std::string> names = {"energy"};
+        if (!contact_interfaces.interfaces().empty())
+          names.emplace_back("peak pressure");
+        for (const auto &i : contact_interfaces.interfaces())
+          for (const char *what : {"peak pressure", "force", "contact length"})
+            names.push_back("interface " + i.name + ": " + what);
+        if (std::find(names.begin(), names.end(), refinement.target_quantity) ==
+            names.end())
+          {
+            std::string list;
+            for (const auto &name : names)
+              list += (list.empty() ? "'" : ", '") + name + "'";
+            AssertThrow(false,
+                        ExcMessage("Refinement/Target quantity '" +
+                                   refinement.target_quantity +
+                                   "' is not one of " + list));
+          }
+      }
     output_writer.prepare();
     set_load_parameter(load_cases.values()[0]);
 
@@ -351,6 +372,7 @@ namespace knee_contact
       if (records.size() > 1)
         print_convergence_table(records,
                                 dim,
+                                !output_writer.test_mode(),
                                 !output_writer.test_mode(),
                                 std::cout);
 

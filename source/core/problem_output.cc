@@ -90,7 +90,8 @@ namespace knee_contact
                                   timer.get_summary_data(
                                     TimerOutput::total_wall_time),
                                   solver_name,
-                                  solver_figures);
+                                  solver_figures,
+                                  error_estimates);
     };
     summary();
     {
@@ -145,6 +146,9 @@ namespace knee_contact
         write_result_set(first_results, sequences, timer);
       }
 
+    // The error bars are those of the first case's mesh sequence; a
+    // further case is solved on the last mesh only, so it has none.
+    error_estimates.clear();
     unsigned int n_failed = 0;
     for (unsigned int c = 1; c < t.size() && contact_solution.converged; ++c)
       {
@@ -226,6 +230,19 @@ namespace knee_contact
         text << (d == 0 ? "(" : ", ") << shown(v[d]);
       return text.str() + ")";
     };
+    // The error bar of a quantity (estimate_errors()), not in test mode:
+    // the test terminal is a regression record of the solution, and the
+    // bars are asserted by their own tests.
+    const auto bar = [this](const std::string &name) {
+      const auto found = error_estimates.find(name);
+      if (output_writer.test_mode() || found == error_estimates.end() ||
+          !std::isfinite(found->second.error))
+        return std::string();
+      std::ostringstream text;
+      text << std::scientific << std::setprecision(1) << " +- "
+           << found->second.error << (found->second.asymptotic ? "" : " (!)");
+      return text.str();
+    };
     out << std::scientific << std::setprecision(6);
     out << "results:\n"
         << "  dofs " << results.n_dofs << ", cells " << results.n_cells
@@ -259,24 +276,46 @@ namespace knee_contact
         << results.equilibrium_residual << std::setprecision(6) << "\n"
         << "  energy a(u,u) " << energy_unit << "          "
         << (std::abs(results.energy) <= energy_noise ? 0. : results.energy)
-        << "\n"
+        << bar("energy") << "\n"
         << "  max |u| [m]                  " << results.max_displacement
         << "\n";
     for (const auto &[id, range] : results.stress_yy_range)
       out << "  tau_yy [Pa] in " << std::left << std::setw(14)
           << materials[id].name << std::right << " ["
-          << shown_stress(range.first) << ", " << shown_stress(range.second)
-          << "]\n";
+          << shown_stress(range.first)
+          << bar(materials[id].name + ": tau_yy min") << ", "
+          << shown_stress(range.second)
+          << bar(materials[id].name + ": tau_yy max") << "]\n";
     if (dim == 3)
       for (const auto &[id, value] : results.von_mises_max)
         out << "  max von Mises [Pa] in " << std::left << std::setw(14)
             << materials[id].name << std::right << " " << shown_stress(value)
-            << "\n";
+            << bar(materials[id].name + ": von Mises max") << "\n";
     for (const auto &i : results.interfaces)
       out << "  contact '" << i.name << "': " << i.n_active << " of "
           << i.n_pairs << " pairs active, force [N/m] " << i.force
-          << ", peak pressure [Pa] " << i.max_pressure
-          << ", contact length [m] " << i.contact_length << "\n";
+          << bar("interface " + i.name + ": force") << ", peak pressure [Pa] "
+          << i.max_pressure << bar("interface " + i.name + ": peak pressure")
+          << ", contact length [m] " << i.contact_length
+          << bar("interface " + i.name + ": contact length") << "\n";
+    // What the bars rest on, once.
+    if (!output_writer.test_mode() && !error_estimates.empty())
+      {
+        const auto &energy = error_estimates.at("energy");
+        out << "  error bars (+-): estimated discretisation errors from the "
+               "run's meshes, "
+            << energy.basis << " for the energy";
+        bool flagged = false;
+        for (const auto &[name, estimate] : error_estimates)
+          flagged =
+            flagged || (std::isfinite(estimate.error) && !estimate.asymptotic);
+        if (flagged)
+          out << "; (!): not in the asymptotic range, a conservative bar";
+        if (!std::isfinite(energy.error))
+          out << " (Refinement/Number of cycles >= 2 gives bars; >= 3 "
+                 "observed orders)";
+        out << "\n";
+      }
     if (!contact_pairs.empty())
       out << "  active-set iterations " << contact_solution.n_iterations
           << (contact_solution.converged ? ", converged" : ", NOT converged")

@@ -266,12 +266,13 @@ namespace knee_contact
   template <int dim>
   void
   OutputWriter<dim>::write_summary(
-    const Results<dim>                  &results,
-    const ContactSolution               &contact,
-    const Materials<dim>                &materials,
-    const std::map<std::string, double> &wall_times,
-    const std::string                   &solver,
-    const std::map<std::string, double> &solver_figures) const
+    const Results<dim>                         &results,
+    const ContactSolution                      &contact,
+    const Materials<dim>                       &materials,
+    const std::map<std::string, double>        &wall_times,
+    const std::string                          &solver,
+    const std::map<std::string, double>        &solver_figures,
+    const std::map<std::string, ErrorEstimate> &estimates) const
   {
     using json = nlohmann::ordered_json;
     json summary;
@@ -289,16 +290,29 @@ namespace knee_contact
     summary["applied_load"]         = vector(results.applied_load);
     summary["equilibrium_residual"] = results.equilibrium_residual;
     summary["energy"]               = results.energy;
-    summary["max_displacement"]     = results.max_displacement;
+    // The error bar of a quantity (null where the run has none).
+    const auto error = [&estimates](const std::string &name) -> json {
+      const auto found = estimates.find(name);
+      if (found == estimates.end() || !std::isfinite(found->second.error))
+        return nullptr;
+      return found->second.error;
+    };
+    summary["energy_error"]     = error("energy");
+    summary["max_displacement"] = results.max_displacement;
     for (const auto &[id, reaction] : results.reactions)
       summary["reactions"][std::to_string(id)] = vector(reaction);
     for (const auto &[id, range] : results.stress_yy_range)
-      summary["stress_yy"][materials[id].name] = {{"material_id", id},
-                                                  {"min", range.first},
-                                                  {"max", range.second}};
+      summary["stress_yy"][materials[id].name] = {
+        {"material_id", id},
+        {"min", range.first},
+        {"max", range.second},
+        {"min_error", error(materials[id].name + ": tau_yy min")},
+        {"max_error", error(materials[id].name + ": tau_yy max")}};
     for (const auto &[id, value] : results.von_mises_max)
-      summary["von_mises_max"][materials[id].name] = {{"material_id", id},
-                                                      {"max", value}};
+      summary["von_mises_max"][materials[id].name] = {
+        {"material_id", id},
+        {"max", value},
+        {"max_error", error(materials[id].name + ": von Mises max")}};
     unsigned int n_pairs = 0, n_active = 0;
     for (const auto &i : results.interfaces)
       {
@@ -311,7 +325,12 @@ namespace knee_contact
           {"force", i.force},
           {"force_on_slave", vector(i.force_on_slave)},
           {"max_pressure", i.max_pressure},
-          {"contact_length", i.contact_length}};
+          {"contact_length", i.contact_length},
+          {"force_error", error("interface " + i.name + ": force")},
+          {"max_pressure_error",
+           error("interface " + i.name + ": peak pressure")},
+          {"contact_length_error",
+           error("interface " + i.name + ": contact length")}};
         if (!contact.lambda_t.empty())
           {
             auto &entry = summary["contact_interfaces"][i.name];
@@ -325,6 +344,18 @@ namespace knee_contact
             entry["max_accumulated_slip"] = i.max_accumulated_slip;
           }
       }
+    // How each bar was made (estimate_errors()).
+    for (const auto &[name, estimate] : estimates)
+      summary["error_estimates"][name] = {
+        {"value", estimate.value},
+        {"error", error(name)},
+        {"extrapolated",
+         std::isfinite(estimate.extrapolated) ? json(estimate.extrapolated)
+                                              : json(nullptr)},
+        {"observed_order",
+         std::isfinite(estimate.order) ? json(estimate.order) : json(nullptr)},
+        {"asymptotic", estimate.asymptotic},
+        {"basis", estimate.basis}};
     summary["n_contact_pairs"]       = n_pairs;
     summary["n_active_pairs"]        = n_active;
     summary["active_set_iterations"] = contact.n_iterations;

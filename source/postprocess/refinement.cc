@@ -56,6 +56,24 @@ namespace knee_contact
       "the active contact zone (one slave vertex spacing around it), where "
       "the pressure is resolved. Both sides of an interface are refined "
       "together.");
+    prm.add_parameter(
+      "Target error",
+      target_error,
+      "0: off. Else the relative error (error bar / value) at which the "
+      "run stops refining: it refines by Strategy (global or adaptive) "
+      "until the error bar of 'Target quantity' is below this fraction of "
+      "its value, at most Number of cycles (global) or Number of adaptive "
+      "cycles (adaptive) meshes, and reports the value with its error bar, "
+      "the DoFs and the time.",
+      Patterns::Double(0, 1));
+    prm.add_parameter(
+      "Target quantity",
+      target_quantity,
+      "The quantity 'Target error' is for: 'peak pressure' (the largest "
+      "over the interfaces), 'energy', or one of an interface 'interface "
+      "NAME: peak pressure', 'interface NAME: force', 'interface NAME: "
+      "contact length' (NAME: Contact/Interface N/Name).",
+      Patterns::Anything());
     prm.leave_subsection();
   }
 
@@ -66,6 +84,10 @@ namespace knee_contact
   {
     if (n_adaptive_cycles == 0)
       n_adaptive_cycles = n_cycles;
+    AssertThrow(target_error == 0 || strategy != Strategy::compare,
+                ExcMessage("Refinement/Target error needs Refinement/"
+                           "Strategy = global or adaptive (compare runs two "
+                           "whole sequences)"));
   }
 
 

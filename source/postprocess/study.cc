@@ -26,6 +26,7 @@ namespace knee_contact
   print_convergence_table(const std::vector<CycleRecord> &records,
                           const unsigned int              dimension,
                           const bool                      with_times,
+                          const bool                      with_estimates,
                           std::ostream                   &out)
   {
     dealii::ConvergenceTable table;
@@ -47,6 +48,17 @@ namespace knee_contact
               table.set_scientific(name, true);
               table.set_precision(name, 3);
             }
+        if (with_estimates)
+          for (const auto &[name, value] :
+               {std::pair<std::string, double>{"est. peak pressure error",
+                                               r.estimated_peak_pressure_error},
+                {"est. energy error", r.estimated_energy_error}})
+            if (r.n_pairs > 0 || name == "est. energy error")
+              {
+                table.add_value(name, value);
+                table.set_scientific(name, true);
+                table.set_precision(name, 2);
+              }
         if (with_times)
           {
             table.add_value("time [s]", r.total_time);
@@ -99,9 +111,15 @@ namespace knee_contact
                                     "factor_memory_MB",
                                     "dense_memory_MB"};
     out << ",time_total,peak_memory_MB,solver";
+    // The error bars of the peak pressure and the energy relative to the
+    // values, from the cycles up to this one (beside the true errors
+    // above: the estimates' effectivity), after the solver's columns.
+    const std::string estimate_columns =
+      ",estimated_peak_pressure_error,estimated_energy_error,"
+      "recovered_energy_error";
     for (const char *column : solver_columns)
       out << ',' << column;
-    out << '\n' << std::setprecision(10);
+    out << estimate_columns << '\n' << std::setprecision(10);
     for (const CycleRecord &r : records)
       {
         out << r.strategy << ',' << r.cycle << ',' << r.n_cells << ','
@@ -120,7 +138,9 @@ namespace knee_contact
             const auto it = r.solver_figures.find(column);
             out << ',' << (it == r.solver_figures.end() ? 0. : it->second);
           }
-        out << '\n';
+        out << ',' << r.estimated_peak_pressure_error << ','
+            << r.estimated_energy_error << ','
+            << r.recovered_energy_error / std::abs(r.energy) << '\n';
       }
   }
 } // namespace knee_contact

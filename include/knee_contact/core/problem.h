@@ -201,6 +201,17 @@ namespace knee_contact
     Results<dim>
     current_results() const;
 
+    /**
+     * The reported quantities of @p results by the names the error
+     * estimates and Refinement/Target quantity use: "energy", "peak
+     * pressure" (the largest of the interfaces), "interface NAME: peak
+     * pressure", "interface NAME: force", "interface NAME: contact length",
+     * "MATERIAL: tau_yy min", "MATERIAL: tau_yy max", "MATERIAL: von Mises
+     * max".
+     */
+    Quantities
+    cycle_quantities(const Results<dim> &results) const;
+
     /** Evaluate loads and exact solutions at load parameter @p t. */
     void
     set_load_parameter(const double t);
@@ -255,6 +266,12 @@ namespace knee_contact
     std::vector<unsigned int>           body_of_cell;
     unsigned int                        n_bodies = 0;
     std::vector<std::string>            body_names;
+
+    /**
+     * The error bars of the reported quantities, from the last sequence of
+     * meshes (estimate_errors()); empty before the first solve.
+     */
+    std::map<std::string, ErrorEstimate> error_estimates;
 
     AffineConstraints<double> constraints;
     ContactPairs<dim>         contact_pairs;

@@ -4,6 +4,7 @@
 #include <knee_contact/contact/contact.h>
 #include <knee_contact/core/result_folder.h>
 #include <knee_contact/physics/materials.h>
+#include <knee_contact/postprocess/error_estimate.h>
 #include <knee_contact/postprocess/results.h>
 #include <knee_contact/solver/active_set.h>
 
@@ -117,12 +118,13 @@ namespace knee_contact
      * its phase times and sizes (section "solver").
      */
     void
-    write_summary(const Results<dim>                  &results,
-                  const ContactSolution               &contact,
-                  const Materials<dim>                &materials,
-                  const std::map<std::string, double> &wall_times,
-                  const std::string                   &solver,
-                  const std::map<std::string, double> &solver_figures) const;
+    write_summary(const Results<dim>                         &results,
+                  const ContactSolution                      &contact,
+                  const Materials<dim>                       &materials,
+                  const std::map<std::string, double>        &wall_times,
+                  const std::string                          &solver,
+                  const std::map<std::string, double>        &solver_figures,
+                  const std::map<std::string, ErrorEstimate> &estimates) const;
 
     /**
      * Print a warning on the terminal and keep it for summary.json

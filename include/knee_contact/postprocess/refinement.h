@@ -70,6 +70,13 @@ namespace knee_contact
     /** Cycles of the adaptive sequence (Strategy = adaptive or compare). */
     unsigned int n_adaptive_cycles = 0;
     Strategy     strategy          = Strategy::global;
+    /**
+     * Refinement/Target error (relative; 0: off) and the quantity it is
+     * for, by the name the error estimates use (see
+     * ContactProblem::cycle_quantities()).
+     */
+    double      target_error    = 0;
+    std::string target_quantity = "peak pressure";
 
   private:
     /**
