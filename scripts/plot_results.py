@@ -7,7 +7,9 @@ draws, each written to a temporary name and renamed:
                         asks, the seed's Fig. 2) over the undeformed outline,
                         bodies coloured by material, labelled points;
   stress_yy.png         the vertical stress tau_yy in MPa (the seed's Fig. 3);
-  contact_pressure.png  the contact pressure in MPa along each interface;
+  contact_pressure.png  the contact pressure in MPa along each interface,
+                        and the peak pressure's error bar as a band where
+                        the run has one;
   contact_friction.png  with friction: along each frictional interface the
                         normal and tangential traction in MPa (and the
                         bound mu p where it is Coulomb), the slip of this
@@ -100,20 +102,31 @@ def stress_yy(folder, material, vertex):
     save(figure, os.path.join(folder, "stress_yy.png"))
 
 
-def contact_pressure(folder):
+def contact_pressure(folder, summary):
     files = sorted(glob.glob(os.path.join(folder, "contact_*.csv")))
     if not files:
         return
     figure, axes = plt.subplots(figsize=(8, 4.5))
+    interfaces = summary.get("contact_interfaces", {})
     for path in files:
         with open(path) as f:
             rows = list(csv.DictReader(f))
         s = np.array([float(r["arc_length"]) for r in rows]) * 1e3
         p = np.array([float(r["pressure"]) for r in rows]) / 1e6
-        name = os.path.basename(path)[len("contact_"):-len(".csv")]
+        interface = os.path.basename(path)[len("contact_"):-len(".csv")]
+        name = interface
         if rows and "discretisation" in rows[0]:
             name += " (%s)" % rows[0]["discretisation"]
-        axes.plot(s, p, ".-", label=name)
+        line, = axes.plot(s, p, ".-", label=name)
+        # The peak pressure's error bar as a band at the peak.
+        entry = interfaces.get(interface, {})
+        error = entry.get("max_pressure_error")
+        if error is not None and len(p) and np.isfinite(error):
+            peak = entry["max_pressure"] / 1e6
+            axes.axhspan(peak - error / 1e6, peak + error / 1e6,
+                         color=line.get_color(), alpha=0.2,
+                         label="%s: peak %.4g +- %.2g MPa" %
+                         (interface, peak, error / 1e6))
     axes.set_xlabel("arc length along the slave side [mm]")
     axes.set_ylabel("contact pressure [MPa]")
     axes.grid(True, alpha=0.3)
@@ -171,7 +184,7 @@ def main():
     material, vertex = read_cells(folder)
     deformation(folder, summary, material, vertex)
     stress_yy(folder, material, vertex)
-    contact_pressure(folder)
+    contact_pressure(folder, summary)
     contact_friction(folder)
 
 

@@ -38,7 +38,7 @@ namespace knee_contact
       scale = std::max(scale, std::abs(v));
     if (std::abs(e21) <= 1e-12 * scale)
       {
-        estimate.error      = std::max(std::abs(e21), 1e-14 * scale);
+        estimate.error      = 1e-12 * scale;
         estimate.asymptotic = true;
         estimate.basis      = "converged to round-off";
         return estimate;

@@ -57,8 +57,8 @@ namespace knee_contact
    * (r21^f - 1) with the formal order f: Roache's two-mesh factor, flagged.
    * With two meshes: 3 |e21| / (r21^f - 1), flagged. A difference at the
    * round-off of the value (1e-12) counts as converged: the bar is that
-   * round-off. Formal orders (@p formal_order): 2 for the energy, 1 for
-   * the others.
+   * round-off, 1e-12 of the value. Formal orders (@p formal_order): 2 for the
+   * energy, 1 for the others.
    *
    * Written here because no library the project uses estimates errors of
    * derived quantities from a mesh sequence (deal.II's ConvergenceTable
