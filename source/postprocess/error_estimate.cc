@@ -50,10 +50,12 @@ namespace knee_contact
         if (std::isfinite(quotient) && quotient > 0 && r10 > 1.01)
           {
             // Celik et al.'s fixed point for the order of non-uniform ratios
-            // (s = 1: monotone convergence).
+            // (s = 1: monotone), without their absolute value: differences
+            // that grow from mesh to mesh (a singular corner's stress) give
+            // a negative order, which is no convergence.
             const double log_quotient = std::log(quotient);
-            double       p            = std::abs(log_quotient) / std::log(r21);
-            bool         ok           = std::isfinite(p);
+            double       p            = log_quotient / std::log(r21);
+            bool         ok           = std::isfinite(p) && p > 0;
             for (unsigned int k = 0; k < 50 && ok; ++k)
               {
                 const double a = std::pow(r21, p) - 1, b = std::pow(r10, p) - 1;
@@ -63,7 +65,12 @@ namespace knee_contact
                     break;
                   }
                 const double next =
-                  std::abs(log_quotient + std::log(a / b)) / std::log(r21);
+                  (log_quotient + std::log(a / b)) / std::log(r21);
+                if (!(next > 0))
+                  {
+                    ok = false;
+                    break;
+                  }
                 if (std::abs(next - p) < 1e-10 * std::max(1., p))
                   {
                     p = next;

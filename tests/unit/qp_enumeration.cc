@@ -12,6 +12,8 @@
 #include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/lapack_full_matrix.h>
 
+#include "free_dofs.h"
+
 #include <iomanip>
 #include <iostream>
 #include <string>
@@ -35,30 +37,12 @@ namespace
     const unsigned int n     = K.m();
 
     // x = C0 z + g0 over the dofs free of Gamma_u.
-    std::vector<unsigned int> free_index(n, numbers::invalid_unsigned_int);
-    unsigned int              n_free = 0;
-    for (unsigned int i = 0; i < n; ++i)
-      if (!base.is_constrained(i))
-        free_index[i] = n_free++;
-    FullMatrix<double> C0(n, n_free), Kfull(n, n);
-    Vector<double>     g0(n);
-    for (unsigned int i = 0; i < n; ++i)
-      if (free_index[i] != numbers::invalid_unsigned_int)
-        C0(i, free_index[i]) = 1;
-      else
-        {
-          g0(i) = base.get_inhomogeneity(i);
-          for (const auto &[j, c] : *base.get_constraint_entries(i))
-            C0(i, free_index[j]) = c;
-        }
-    Kfull.copy_from(K);
-    FullMatrix<double> KC(n, n_free), H(n_free, n_free);
-    Kfull.mmult(KC, C0);
-    C0.Tmmult(H, KC);
-    Vector<double> Kg(n), fmKg(f), b(n_free);
-    Kfull.vmult(Kg, g0);
-    fmKg -= Kg;
-    C0.Tvmult(b, fmKg);
+    const FreeDofs     reduced(K, f, base);
+    const unsigned int n_free = reduced.n_free;
+    const auto        &C0     = reduced.C0;
+    const auto        &H      = reduced.H;
+    const auto        &g0     = reduced.g0;
+    const auto        &b      = reduced.b;
 
     const unsigned int M = pairs.size();
     FullMatrix<double> A(M, n_free);
