@@ -137,18 +137,9 @@ namespace knee_contact
           // mesh sequence's differences gave 0.95 to 43 on adaptive
           // meshes, whose energies do not converge monotonically).
           if (std::isfinite(record.recovered_energy_error))
-            {
-              ErrorEstimate &energy = error_estimates["energy"];
-              energy.value          = record.energy;
-              // Below the energy's own round-off the bar is that round-off
-              // (an exactly represented solution: a patch test).
-              energy.error = std::max(1.25 * record.recovered_energy_error,
-                                      1e-13 * std::abs(record.energy));
-              energy.extrapolated = std::numeric_limits<double>::quiet_NaN();
-              energy.order        = std::numeric_limits<double>::quiet_NaN();
-              energy.asymptotic   = true;
-              energy.basis = "strain recovery (Zienkiewicz-Zhu) on this mesh";
-            }
+            error_estimates["energy"] =
+              recovered_energy_estimate(record.energy,
+                                        record.recovered_energy_error);
           const auto relative = [&](const std::string &name) {
             const auto found = error_estimates.find(name);
             return found == error_estimates.end()

@@ -44,9 +44,11 @@ namespace knee_contact
    * J. Fluids Eng. 130, 078001, 2008), where the refinement ratio of
    * meshes that are not uniformly refined is r = (N_fine / N_coarse)^(1 /
    * dim) (N: degrees of freedom). With the last three meshes (values Q0,
-   * Q1, Q2 from coarse to fine), e21 = Q2 - Q1, e10 = Q1 - Q0: the order p
-   * solves p ln r21 = |ln |e10 / e21| + ln((r21^p - s) / (r10^p - s))|,
-   * s = sign(e10 / e21), and the bar is 1.25 |e21| / (r21^q - 1), q =
+   * Q1, Q2 from coarse to fine), e21 = Q2 - Q1, e10 = Q1 - Q0: where they
+   * have one sign the order p solves p ln r21 = ln(e10 / e21) +
+   * ln((r21^p - 1) / (r10^p - 1)) (Celik's equation without its absolute
+   * value: differences that grow give p <= 0, no convergence), and the bar
+   * is 1.25 |e21| / (r21^q - 1), q =
    * min(p, formal order) (the Richardson estimate with Roache's safety
    * factor for three meshes; an order above the formal one is not relied
    * on: measured on the two rings, the observed order of the pressure
@@ -71,6 +73,15 @@ namespace knee_contact
   estimate_errors(const std::vector<Quantities> &cycles,
                   const std::vector<double>     &n_dofs,
                   const unsigned int             dim);
+
+  /**
+   * The energy's bar from one mesh: 1.25 @p eta_squared (the strain
+   * recovery's estimate of a(u - u_h, u - u_h), recovered_energy_error(),
+   * with Roache's safety factor), at least the energy's round-off, 1e-13
+   * of @p energy (an exactly represented solution: a patch test).
+   */
+  ErrorEstimate
+  recovered_energy_estimate(const double energy, const double eta_squared);
 
   /**
    * One estimate from the last two or three values (see estimate_errors);
