@@ -5,34 +5,63 @@
 
 #include <deal.II/fe/fe_values.h>
 
+#include <cmath>
 #include <map>
 #include <utility>
 #include <vector>
 
 namespace knee_contact
 {
-  template <int dim>
-  double
-  recovered_energy_error(const DoFHandler<dim> &dof_handler,
-                         const Vector<double>  &solution,
-                         const Materials<dim>  &materials)
+  namespace
   {
-    const FiniteElement<dim>        &fe         = dof_handler.get_fe();
-    const ReferenceCell              kind       = fe.reference_cell();
-    const unsigned int               n_vertices = kind.n_vertices();
-    const FEValuesExtractors::Vector displacement(0);
+    using VertexKey = std::pair<unsigned int, types::material_id>;
 
-    // The strain at the vertices of every cell (the nodal rule's points are
-    // the vertices in deal.II's order), averaged per (vertex, material).
-    std::map<std::pair<unsigned int, types::material_id>,
-             std::pair<SymmetricTensor<2, dim>, unsigned int>>
-      averages;
+    // The stiffness tensor of @p material (its stress of each unit strain),
+    // to turn a recovered stress back into a strain.
+    template <int dim>
+    SymmetricTensor<4, dim>
+    stiffness(const Material<dim> &material)
     {
+      SymmetricTensor<4, dim> c;
+      for (unsigned int i = 0; i < dim; ++i)
+        for (unsigned int j = i; j < dim; ++j)
+          {
+            // e_ij = e_ji = 1/2 off the diagonal: C : e = C_..ij.
+            SymmetricTensor<2, dim> unit;
+            unit[i][j] = (i == j ? 1. : 0.5);
+            const SymmetricTensor<2, dim> stress = material.stress(unit);
+            for (unsigned int k = 0; k < dim; ++k)
+              for (unsigned int l = k; l < dim; ++l)
+                c[k][l][i][j] = stress[k][l];
+          }
+      return c;
+    }
+
+
+
+    // The strain of @p solution at the vertices of every cell (the nodal
+    // rule's points are the vertices in deal.II's order), averaged per
+    // (vertex, material); at the vertices of @p tractions the normal part
+    // of the average's stress replaced by the traction.
+    template <int dim>
+    std::map<VertexKey, SymmetricTensor<2, dim>>
+    vertex_strains(const DoFHandler<dim>                   &dof_handler,
+                   const Vector<double>                    &solution,
+                   const Materials<dim>                    &materials,
+                   const std::vector<SurfaceTraction<dim>> &tractions)
+    {
+      const FiniteElement<dim> &fe         = dof_handler.get_fe();
+      const ReferenceCell       kind       = fe.reference_cell();
+      const unsigned int        n_vertices = kind.n_vertices();
+      std::map<VertexKey, std::pair<SymmetricTensor<2, dim>, unsigned int>>
+                                                   sums;
+      std::map<types::global_dof_index, VertexKey> vertex_of_dof;
       FEValues<dim>                        nodal(elements::mapping(dof_handler),
                           fe,
                           kind.template get_nodal_type_quadrature<dim>(),
                           update_gradients);
       std::vector<SymmetricTensor<2, dim>> strains(n_vertices);
+      const FEValuesExtractors::Vector     displacement(0);
       for (const auto &cell : dof_handler.active_cell_iterators())
         {
           nodal.reinit(cell);
@@ -40,57 +69,151 @@ namespace knee_contact
                                                                strains);
           for (unsigned int v = 0; v < n_vertices; ++v)
             {
-              auto &[sum, count] =
-                averages[{cell->vertex_index(v), cell->material_id()}];
+              const VertexKey key{cell->vertex_index(v), cell->material_id()};
+              auto &[sum, count] = sums[key];
               sum += strains[v];
               ++count;
+              if (!tractions.empty())
+                vertex_of_dof[cell->vertex_dof_index(v, 0)] = key;
             }
         }
-    }
+      std::map<VertexKey, SymmetricTensor<2, dim>> averages;
+      for (const auto &[key, entry] : sums)
+        averages[key] = entry.first / double(entry.second);
 
-    // eta^2: the recovered strain interpolated with the scalar linear
-    // shape function of each vertex (component 0 of the vector element).
+      // sigma* = P sigma P - p n (x) n with P = I - n (x) n: the tangential
+      // stress of the average stays, the normal traction is the contact's.
+      std::map<types::material_id, SymmetricTensor<4, dim>> compliances;
+      for (const SurfaceTraction<dim> &traction : tractions)
+        {
+          const auto found = vertex_of_dof.find(traction.dof);
+          if (found == vertex_of_dof.end())
+            continue;
+          const types::material_id id       = found->second.second;
+          const Material<dim>     &material = materials[id];
+          auto compliance = compliances.find(id);
+          if (compliance == compliances.end())
+            compliance =
+              compliances.emplace(id, invert(stiffness(material))).first;
+          SymmetricTensor<2, dim> &strain = averages[found->second];
+          const Tensor<1, dim>    &n      = traction.normal;
+          Tensor<2, dim>           P      = unit_symmetric_tensor<dim>();
+          P -= outer_product(n, n);
+          Tensor<2, dim> stress = P * Tensor<2, dim>(material.stress(strain)) * P;
+          stress -= traction.pressure * outer_product(n, n);
+          strain = compliance->second * symmetrize(stress);
+        }
+      return averages;
+    }
+  } // namespace
+
+
+
+  template <int dim>
+  RecoveredProduct
+  recovered_error_product(const DoFHandler<dim>                   &dof_handler,
+                          const Vector<double>                    &u,
+                          const Vector<double>                    &z,
+                          const Materials<dim>                    &materials,
+                          const std::vector<SurfaceTraction<dim>> &tractions_u,
+                          const std::vector<SurfaceTraction<dim>> &tractions_z,
+                          const bool with_indicators)
+  {
+    const FiniteElement<dim>        &fe = dof_handler.get_fe();
+    const unsigned int               n_vertices = fe.reference_cell().n_vertices();
+    const FEValuesExtractors::Vector displacement(0);
+    const bool                       same = &u == &z && tractions_z.empty();
+    const auto averages_u =
+      vertex_strains(dof_handler, u, materials, tractions_u);
+    const auto averages_z =
+      same ? averages_u :
+             vertex_strains(dof_handler, z, materials, tractions_z);
+
     FEValues<dim>      fe_values(elements::mapping(dof_handler),
                             fe,
                             elements::cell_quadrature(dof_handler, 2),
                             update_values | update_gradients |
                               update_JxW_values);
     const unsigned int n_q = fe_values.n_quadrature_points;
-    std::vector<SymmetricTensor<2, dim>> strains(n_q);
-    std::vector<SymmetricTensor<2, dim>> recovered(n_vertices);
-    double                               eta_squared = 0;
+    std::vector<SymmetricTensor<2, dim>> strains_u(n_q), strains_z(n_q);
+    std::vector<SymmetricTensor<2, dim>> recovered_u(n_vertices),
+      recovered_z(n_vertices);
+    RecoveredProduct result;
+    if (with_indicators)
+      result.indicators.reinit(
+        dof_handler.get_triangulation().n_active_cells());
     for (const auto &cell : dof_handler.active_cell_iterators())
       {
         fe_values.reinit(cell);
-        fe_values[displacement].get_function_symmetric_gradients(solution,
-                                                                 strains);
+        fe_values[displacement].get_function_symmetric_gradients(u, strains_u);
+        if (!same)
+          fe_values[displacement].get_function_symmetric_gradients(z,
+                                                                   strains_z);
         const Material<dim> &material = materials[cell->material_id()];
         for (unsigned int v = 0; v < n_vertices; ++v)
           {
-            const auto &[sum, count] =
-              averages.at({cell->vertex_index(v), cell->material_id()});
-            recovered[v] = sum / double(count);
+            const VertexKey key{cell->vertex_index(v), cell->material_id()};
+            recovered_u[v] = averages_u.at(key);
+            recovered_z[v] = averages_z.at(key);
           }
+        double product = 0;
         for (unsigned int q = 0; q < n_q; ++q)
           {
-            SymmetricTensor<2, dim> difference = -strains[q];
+            // The recovered strains interpolated with the scalar linear
+            // shape function of each vertex (component 0 of the vector
+            // element), minus the discrete ones.
+            SymmetricTensor<2, dim> error_u = -strains_u[q];
+            SymmetricTensor<2, dim> error_z =
+              same ? SymmetricTensor<2, dim>() : -strains_z[q];
             for (unsigned int v = 0; v < n_vertices; ++v)
-              difference +=
-                fe_values.shape_value(fe.component_to_system_index(0, v), q) *
-                recovered[v];
-            eta_squared +=
-              difference * material.stress(difference) * fe_values.JxW(q);
+              {
+                const double phi =
+                  fe_values.shape_value(fe.component_to_system_index(0, v), q);
+                error_u += phi * recovered_u[v];
+                if (!same)
+                  error_z += phi * recovered_z[v];
+              }
+            if (same)
+              error_z = error_u;
+            const SymmetricTensor<2, dim> stress_u = material.stress(error_u);
+            product += error_z * stress_u * fe_values.JxW(q);
+            result.eta_u_squared += error_u * stress_u * fe_values.JxW(q);
           }
+        result.product += product;
+        if (with_indicators)
+          result.indicators(cell->active_cell_index()) = std::abs(product);
       }
-    return eta_squared;
+    return result;
   }
 
-  template double
-  recovered_energy_error(const DoFHandler<2> &,
-                         const Vector<double> &,
-                         const Materials<2> &);
-  template double
-  recovered_energy_error(const DoFHandler<3> &,
-                         const Vector<double> &,
-                         const Materials<3> &);
+
+
+  template <int dim>
+  double
+  recovered_energy_error(const DoFHandler<dim> &dof_handler,
+                         const Vector<double>  &solution,
+                         const Materials<dim>  &materials)
+  {
+    return recovered_error_product(
+             dof_handler, solution, solution, materials, {}, {})
+      .eta_u_squared;
+  }
+
+
+
+#define KNEE_CONTACT_INSTANTIATE(dim)                                     \
+  template RecoveredProduct recovered_error_product(                      \
+    const DoFHandler<dim> &,                                              \
+    const Vector<double> &,                                               \
+    const Vector<double> &,                                               \
+    const Materials<dim> &,                                               \
+    const std::vector<SurfaceTraction<dim>> &,                            \
+    const std::vector<SurfaceTraction<dim>> &,                            \
+    const bool);                                                          \
+  template double recovered_energy_error(const DoFHandler<dim> &,         \
+                                         const Vector<double> &,          \
+                                         const Materials<dim> &);
+  KNEE_CONTACT_INSTANTIATE(2)
+  KNEE_CONTACT_INSTANTIATE(3)
+#undef KNEE_CONTACT_INSTANTIATE
 } // namespace knee_contact

@@ -101,7 +101,8 @@ namespace knee_contact
                      const Materials<dim>    &materials,
                      const ContactInterfaces &interfaces,
                      const ContactPairs<dim> &pairs,
-                     const ContactSolution   &contact) const
+                     const ContactSolution   &contact,
+                     const Vector<float>     *goal) const
   {
     if (strategy == Strategy::global)
       {
@@ -109,16 +110,22 @@ namespace knee_contact
         return;
       }
     Vector<float> kelly(triangulation.n_active_cells());
-    KellyErrorEstimator<dim>::estimate(elements::mapping(dof_handler),
-                                       dof_handler,
-                                       elements::face_quadrature(dof_handler,
-                                                                 2),
-                                       {},
-                                       solution,
-                                       kelly);
-    for (const auto &cell : triangulation.active_cell_iterators())
-      kelly(cell->active_cell_index()) *=
-        std::sqrt(materials[cell->material_id()].youngs_modulus);
+    if (goal != nullptr && goal->size() == kelly.size() &&
+        goal->l1_norm() > 0)
+      kelly = *goal;
+    else
+      {
+        KellyErrorEstimator<dim>::estimate(
+          elements::mapping(dof_handler),
+          dof_handler,
+          elements::face_quadrature(dof_handler, 2),
+          {},
+          solution,
+          kelly);
+        for (const auto &cell : triangulation.active_cell_iterators())
+          kelly(cell->active_cell_index()) *=
+            std::sqrt(materials[cell->material_id()].youngs_modulus);
+      }
     GridRefinement::refine_and_coarsen_fixed_fraction(triangulation,
                                                       kelly,
                                                       refine_fraction,
@@ -237,7 +244,8 @@ namespace knee_contact
                      const Materials<2> &,
                      const ContactInterfaces &,
                      const ContactPairs<2> &,
-                     const ContactSolution &) const;
+                     const ContactSolution &,
+                     const Vector<float> *) const;
   template void
   Refinement::refine(const Strategy,
                      Triangulation<3> &,
@@ -246,5 +254,6 @@ namespace knee_contact
                      const Materials<3> &,
                      const ContactInterfaces &,
                      const ContactPairs<3> &,
-                     const ContactSolution &) const;
+                     const ContactSolution &,
+                     const Vector<float> *) const;
 } // namespace knee_contact

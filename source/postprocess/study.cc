@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <iomanip>
+#include <limits>
+#include <tuple>
 
 namespace knee_contact
 {
@@ -18,6 +20,28 @@ namespace knee_contact
        {"pressure L2 error", &Errors::pressure_l2_relative},
        {"energy vs reference", &Errors::energy_reference_relative},
        {"extreme stress_yy error", &Errors::stress_extreme_relative}};
+
+    // The effectivity indices of the error bars: the estimated relative
+    // error over the true one, where the run knows the true one (a
+    // Verification reference or an exact solution); NaN otherwise. The
+    // energy's true error is |a(u_h,u_h) - a_ref| / a_ref, or with an exact
+    // solution a(u - u_h, u - u_h) / a(u,u) = energy_relative^2.
+    std::pair<double, double>
+    effectivities(const CycleRecord &r)
+    {
+      const double true_energy =
+        std::isfinite(r.errors.energy_reference_relative) ?
+          r.errors.energy_reference_relative :
+          r.errors.energy_relative * r.errors.energy_relative;
+      const auto ratio = [](const double estimate, const double error) {
+        return std::isfinite(estimate) && std::isfinite(error) && error > 0 ?
+                 estimate / error :
+                 std::numeric_limits<double>::quiet_NaN();
+      };
+      return {ratio(r.estimated_peak_pressure_error,
+                    r.errors.peak_pressure_relative),
+              ratio(r.estimated_energy_error, true_energy)};
+    }
   } // namespace
 
 
@@ -59,6 +83,27 @@ namespace knee_contact
                 table.set_scientific(name, true);
                 table.set_precision(name, 2);
               }
+        // Beside the bars, their effectivity where the true error is
+        // known (bar / true error: above 1 the bar holds the error).
+        if (with_estimates)
+          {
+            const auto [peak, energy] = effectivities(r);
+            const auto &first         = effectivities(records.front());
+            for (const auto &[name, value, shown] :
+                 {std::tuple<std::string, double, bool>{
+                    "peak effectivity",
+                    peak,
+                    r.n_pairs > 0 &&
+                      std::isfinite(records.back().errors.peak_pressure_relative)},
+                  {"energy effectivity",
+                   energy,
+                   std::isfinite(first.second)}})
+              if (shown)
+                {
+                  table.add_value(name, value);
+                  table.set_precision(name, 2);
+                }
+          }
         if (with_times)
           {
             table.add_value("time [s]", r.total_time);
@@ -116,7 +161,7 @@ namespace knee_contact
     // above: the estimates' effectivity), after the solver's columns.
     const std::string estimate_columns =
       ",estimated_peak_pressure_error,estimated_energy_error,"
-      "recovered_energy_error";
+      "recovered_energy_error,peak_pressure_effectivity,energy_effectivity";
     for (const char *column : solver_columns)
       out << ',' << column;
     out << estimate_columns << '\n' << std::setprecision(10);
@@ -140,7 +185,9 @@ namespace knee_contact
           }
         out << ',' << r.estimated_peak_pressure_error << ','
             << r.estimated_energy_error << ','
-            << r.recovered_energy_error / std::abs(r.energy) << '\n';
+            << r.recovered_energy_error / std::abs(r.energy) << ','
+            << effectivities(r).first << ',' << effectivities(r).second
+            << '\n';
       }
   }
 } // namespace knee_contact

@@ -158,6 +158,19 @@ namespace knee_contact
       return contact_solution;
     }
 
+    /**
+     * The influence (dual) solution of the multiplier lambda_p of contact
+     * pair @p p, with the active set of the last solve held (frictionless):
+     * z with C z + A_active^T mu = 0 under the homogeneous constraints and
+     * a_q . z = delta_pq for the active pairs q, so that a change dd of the
+     * load changes lambda_p by z . dd (the KKT matrix is symmetric). By
+     * linearity it is (x(g + s e_p) - x(g)) / s: one more solve of the
+     * factorised contact system with the pair's gap moved by s (the
+     * gaps are restored after). @p mu receives the multipliers of z.
+     */
+    Vector<double>
+    multiplier_influence(const unsigned int p, std::vector<double> &mu);
+
   private:
     /** The parts without a scene: for read_counts() and print_parameters(). */
     ContactProblem() = default;
@@ -272,6 +285,38 @@ namespace knee_contact
      * meshes (estimate_errors()); empty before the first solve.
      */
     std::map<std::string, ErrorEstimate> error_estimates;
+    /**
+     * Per reported peak pressure ("peak pressure", "interface NAME: peak
+     * pressure"): the cells' shares of its goal-oriented estimate
+     * (estimate_pressure_errors()), a refinement indicator that serves it.
+     */
+    std::map<std::string, Vector<float>> goal_indicators;
+
+    /**
+     * The goal-oriented error bars of each interface's peak pressure
+     * (frictionless contact): the influence of the peak pair's
+     * multiplier (multiplier_influence()) weights the recovered strain
+     * errors (recovered_error_product()); bar 1.25 |estimate|. Where
+     * error_estimates already holds a bar from a uniformly refined
+     * sequence (@p uniform), the larger of the two is kept: the
+     * recovery does not see the error of curved boundaries approximated by
+     * straight edges, the sequence does. Fills goal_indicators.
+     */
+    void
+    estimate_pressure_errors(const Results<dim> &results, const bool uniform);
+
+    /**
+     * In target mode for a peak pressure: that pressure's goal indicator
+     * (the adaptive refinement serves it); else none (Kelly's).
+     */
+    const Vector<float> *
+    goal_indicator() const
+    {
+      const auto found = goal_indicators.find(refinement.target_quantity);
+      return refinement.target_error > 0 && found != goal_indicators.end()
+               ? &found->second
+               : nullptr;
+    }
 
     AffineConstraints<double> constraints;
     ContactPairs<dim>         contact_pairs;

@@ -7,6 +7,7 @@
 
 #include <ostream>
 #include <string>
+#include <limits>
 #include <vector>
 
 namespace knee_contact
@@ -57,6 +58,13 @@ namespace knee_contact
       /** Wall time of the case's solve [s]: load vector to displacement. */
       double       solve_time = 0;
       Results<dim> results;
+      /**
+       * The energy's error bar [J/m in 2D, J in 3D]: strain recovery on the
+       * case's mesh (recovered_energy_estimate()); NaN without one.
+       */
+      double energy_error = std::numeric_limits<double>::quiet_NaN();
+      /** The largest peak pressure's error bar [Pa]; NaN without one. */
+      double peak_pressure_error = std::numeric_limits<double>::quiet_NaN();
     };
 
     /**

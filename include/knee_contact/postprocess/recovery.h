@@ -3,27 +3,82 @@
 
 #include <knee_contact/physics/materials.h>
 
+#include <deal.II/base/tensor.h>
+
 #include <deal.II/lac/vector.h>
 
 #include <deal.II/dofs/dof_handler.h>
+
+#include <vector>
 
 namespace knee_contact
 {
   using namespace dealii;
 
   /**
-   * The Zienkiewicz-Zhu estimate of the energy-norm error a(u - u_h, u -
-   * u_h) by strain recovery: the strain of @p solution averaged at each
-   * vertex over the cells of one material that share it (so that a bonded
-   * material junction, where the strain jumps, is not smoothed over), the
-   * averages interpolated by the cells' own linear shape functions, and
-   * eta^2 = sum over cells of the integral of (e* - e_h) : C : (e* - e_h).
-   * eta^2 estimates the error of the energy a(u, u) that the run reports
-   * (Galerkin orthogonality: a(u, u) - a(u_h, u_h) = a(u - u_h, u - u_h)
-   * for the linear problem; with contact up to the contact terms).
+   * A traction a recovered stress must have at a surface vertex: sigma n =
+   * -pressure n (frictionless contact: no tangential part), for the vertex
+   * whose first displacement dof is @p dof.
+   */
+  template <int dim>
+  struct SurfaceTraction
+  {
+    types::global_dof_index dof = 0;
+    Tensor<1, dim>          normal;
+    double                  pressure = 0;
+  };
+
+
+
+  /**
+   * Strain recovery of two displacements u and z on one mesh. Each strain
+   * is averaged at each vertex over the cells of one material that share
+   * it (so that a bonded material junction, where the strain jumps, is not
+   * smoothed over); at a contact vertex listed in @p tractions_u
+   * (@p tractions_z) the average's normal stress is replaced by the known
+   * contact traction (sigma* n = -p n: the recovered stress satisfies the
+   * boundary condition the discrete multiplier gives); the averages are
+   * interpolated by the cells' own linear shape functions. With e_u =
+   * e*(u_h) - e(u_h) and e_z likewise, per cell K:
+   *   product_K = integral over K of e_z : C : e_u   (estimates a(u - u_h,
+   *               z - z_h) on K),
+   *   eta_u,K^2 = integral over K of e_u : C : e_u.
+   * With z the influence (dual) solution of a quantity J, the sum of
+   * product_K estimates the error J(u) - J(u_h) (goal-oriented error
+   * estimation by recovery; the error representation of Becker and
+   * Rannacher, Acta Numerica 2001, with the recovered strains in place of
+   * the exact ones), and |product_K| indicates where to refine for J.
    *
    * Written here because deal.II's estimators (Kelly) give indicators with
-   * an unknown constant, not an error in the quantity's units.
+   * an unknown constant, not an error in the quantity's units, and no
+   * library the project uses recovers strains or weights them by a dual.
+   */
+  struct RecoveredProduct
+  {
+    /** Sum over cells of product_K. */
+    double product = 0;
+    /** Sum over cells of eta_u,K^2. */
+    double eta_u_squared = 0;
+    /** |product_K| by active cell index (if asked for). */
+    Vector<float> indicators;
+  };
+
+  template <int dim>
+  RecoveredProduct
+  recovered_error_product(const DoFHandler<dim>                   &dof_handler,
+                          const Vector<double>                    &u,
+                          const Vector<double>                    &z,
+                          const Materials<dim>                    &materials,
+                          const std::vector<SurfaceTraction<dim>> &tractions_u,
+                          const std::vector<SurfaceTraction<dim>> &tractions_z,
+                          const bool with_indicators = false);
+
+  /**
+   * The Zienkiewicz-Zhu estimate eta^2 of a(u - u_h, u - u_h): the
+   * recovery above of @p solution alone (no contact tractions). eta^2
+   * estimates the error of the energy a(u, u) that the run reports
+   * (Galerkin orthogonality: a(u, u) - a(u_h, u_h) = a(u - u_h, u - u_h)
+   * for the linear problem; with contact up to the contact terms).
    */
   template <int dim>
   double

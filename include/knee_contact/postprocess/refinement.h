@@ -51,6 +51,10 @@ namespace knee_contact
      * estimator of the displacement gradient jumps, weighted by sqrt(E) of
      * each cell so that it estimates the energy norm error a(e, e)^1/2
      * across materials; refinement by fixed fraction of the estimate.
+     * With @p goal (one value per active cell: the cells' shares of a
+     * quantity's goal-oriented error estimate, as Target quantity's peak
+     * pressure has) that indicator takes Kelly's place: the refinement
+     * serves the quantity.
      */
     template <int dim>
     void
@@ -61,7 +65,8 @@ namespace knee_contact
            const Materials<dim>    &materials,
            const ContactInterfaces &interfaces,
            const ContactPairs<dim> &pairs,
-           const ContactSolution   &contact) const;
+           const ContactSolution   &contact,
+           const Vector<float>     *goal = nullptr) const;
 
     static std::string
     name(const Strategy strategy);

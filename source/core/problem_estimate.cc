@@ -1,0 +1,151 @@
+// Goal-oriented error bars of the contact pressures: the influence (dual)
+// solution of a pair's multiplier and its weighting of the recovered strain
+// errors.
+#include <knee_contact/core/problem.h>
+#include <knee_contact/postprocess/recovery.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace knee_contact
+{
+  template <int dim>
+  Vector<double>
+  ContactProblem<dim>::multiplier_influence(const unsigned int   p,
+                                            std::vector<double> &mu)
+  {
+    AssertThrow(contact_system && contact_pairs.tangential.empty() &&
+                  p < contact_pairs.size() && contact_solution.active[p],
+                ExcMessage("multiplier_influence: an active pair of a "
+                           "solved frictionless problem"));
+    // The contact system solves with the gaps of the rows it holds
+    // (contact_pairs.rows without friction): move pair p's, solve once with
+    // the active set held, restore. Any step serves (the solution is
+    // affine in the gaps); one of the size of the displacement keeps the
+    // difference clear of round-off.
+    const double step = std::max(displacement.linfty_norm(), 1e-300);
+    ContactRow  &row  = contact_pairs.rows[p];
+    row.gap += step;
+    row.reduced_gap += step;
+    contact_system->gaps_changed();
+    std::vector<double> excess(contact_pairs.size());
+    mu.assign(contact_pairs.size(), 0.);
+    Vector<double> z(dof_handler.n_dofs());
+    try
+      {
+        contact_system->solve(contact_solution.active, excess, mu);
+        contact_system->solution(z);
+      }
+    catch (...)
+      {
+        row.gap -= step;
+        row.reduced_gap -= step;
+        contact_system->gaps_changed();
+        throw;
+      }
+    row.gap -= step;
+    row.reduced_gap -= step;
+    contact_system->gaps_changed();
+    z -= displacement;
+    z /= step;
+    for (unsigned int q = 0; q < mu.size(); ++q)
+      mu[q] = (mu[q] - contact_solution.lambda[q]) / step;
+    return z;
+  }
+
+
+
+  template <int dim>
+  void
+  ContactProblem<dim>::estimate_pressure_errors(const Results<dim> &results,
+                                                const bool          uniform)
+  {
+    goal_indicators.clear();
+    if (!contact_system || !contact_pairs.tangential.empty() ||
+        !contact_solution.converged ||
+        contact_solution.lambda.size() != contact_pairs.size())
+      return;
+    // The contact tractions of the solution, for its recovered stresses.
+    std::vector<SurfaceTraction<dim>> tractions_u(contact_pairs.size());
+    for (unsigned int q = 0; q < contact_pairs.size(); ++q)
+      tractions_u[q] = {contact_pairs.points[q].slave_dofs[0],
+                        contact_pairs.points[q].normal,
+                        results.pressure[q]};
+    std::string overall;
+    double      overall_peak = 0;
+    for (unsigned int i = 0; i < results.interfaces.size(); ++i)
+      {
+        // The interface's peak pair: J = lambda_p / length_p.
+        int    peak_pair = -1;
+        double peak      = 0;
+        for (unsigned int q = 0; q < contact_pairs.size(); ++q)
+          if (contact_pairs.rows[q].interface == i &&
+              contact_solution.active[q] && results.pressure[q] > peak)
+            {
+              peak      = results.pressure[q];
+              peak_pair = q;
+            }
+        if (peak_pair < 0)
+          continue;
+        std::vector<double> mu;
+        Vector<double>      z = multiplier_influence(peak_pair, mu);
+        const double        length = contact_pairs.rows[peak_pair].length;
+        z /= length;
+        std::vector<SurfaceTraction<dim>> tractions_z = tractions_u;
+        for (unsigned int q = 0; q < contact_pairs.size(); ++q)
+          tractions_z[q].pressure =
+            mu[q] / length / contact_pairs.rows[q].length;
+        RecoveredProduct estimate = recovered_error_product(
+          dof_handler, displacement, z, materials, tractions_u, tractions_z, true);
+
+        const std::string name =
+          "interface " + results.interfaces[i].name + ": peak pressure";
+        ErrorEstimate goal;
+        goal.value = peak;
+        // J(u) - J(u_h) ~ the product: its sign says which side the
+        // exact value lies on.
+        goal.extrapolated = peak + estimate.product;
+        goal.error        = 1.25 * std::abs(estimate.product);
+        goal.asymptotic   = true;
+        goal.basis =
+          "goal-oriented: the peak pair's influence and strain recovery";
+        const auto sequence = error_estimates.find(name);
+        if (uniform && sequence != error_estimates.end() &&
+            std::isfinite(sequence->second.error) &&
+            sequence->second.error > goal.error)
+          {
+            goal.error      = sequence->second.error;
+            goal.asymptotic = sequence->second.asymptotic;
+            goal.order      = sequence->second.order;
+            goal.basis      = "the larger of the goal-oriented bar and the "
+                         "uniform sequence's (" +
+                         sequence->second.basis + ")";
+          }
+        error_estimates[name] = goal;
+        goal_indicators[name] = std::move(estimate.indicators);
+        if (peak > overall_peak)
+          {
+            overall_peak = peak;
+            overall      = name;
+          }
+      }
+    if (!overall.empty())
+      {
+        error_estimates["peak pressure"] = error_estimates.at(overall);
+        goal_indicators["peak pressure"] = goal_indicators.at(overall);
+      }
+  }
+
+
+
+  template Vector<double>
+  ContactProblem<2>::multiplier_influence(const unsigned int,
+                                          std::vector<double> &);
+  template Vector<double>
+  ContactProblem<3>::multiplier_influence(const unsigned int,
+                                          std::vector<double> &);
+  template void
+  ContactProblem<2>::estimate_pressure_errors(const Results<2> &, const bool);
+  template void
+  ContactProblem<3>::estimate_pressure_errors(const Results<3> &, const bool);
+} // namespace knee_contact
