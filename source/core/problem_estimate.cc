@@ -6,28 +6,36 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace knee_contact
 {
   template <int dim>
   Vector<double>
-  ContactProblem<dim>::multiplier_influence(const unsigned int   p,
-                                            std::vector<double> &mu)
+  ContactProblem<dim>::multiplier_influence(
+    const std::vector<unsigned int> &patch,
+    std::vector<double>             &mu)
   {
-    AssertThrow(contact_system && contact_pairs.tangential.empty() &&
-                  p < contact_pairs.size() && contact_solution.active[p],
-                ExcMessage("multiplier_influence: an active pair of a "
-                           "solved frictionless problem"));
+    for (const unsigned int p : patch)
+      AssertThrow(contact_system && contact_pairs.tangential.empty() &&
+                    p < contact_pairs.size() && contact_solution.active[p],
+                  ExcMessage("multiplier_influence: active pairs of a "
+                             "solved frictionless problem"));
     // The contact system solves with the gaps of the rows it holds
     // (contact_pairs.rows without friction): move pair p's, solve once with
     // the active set held, restore. Any step serves (the solution is
     // affine in the gaps); one of the size of the displacement keeps the
     // difference clear of round-off.
     const double step = std::max(displacement.linfty_norm(), 1e-300);
-    ContactRow  &row  = contact_pairs.rows[p];
-    row.gap += step;
-    row.reduced_gap += step;
-    contact_system->gaps_changed();
+    const auto   move = [&](const double by) {
+      for (const unsigned int p : patch)
+        {
+          contact_pairs.rows[p].gap += by;
+          contact_pairs.rows[p].reduced_gap += by;
+        }
+      contact_system->gaps_changed();
+    };
+    move(step);
     std::vector<double> excess(contact_pairs.size());
     mu.assign(contact_pairs.size(), 0.);
     Vector<double> z(dof_handler.n_dofs());
@@ -38,14 +46,10 @@ namespace knee_contact
       }
     catch (...)
       {
-        row.gap -= step;
-        row.reduced_gap -= step;
-        contact_system->gaps_changed();
+        move(-step);
         throw;
       }
-    row.gap -= step;
-    row.reduced_gap -= step;
-    contact_system->gaps_changed();
+    move(-step);
     z -= displacement;
     z /= step;
     for (unsigned int q = 0; q < mu.size(); ++q)
@@ -88,8 +92,30 @@ namespace knee_contact
         if (peak_pair < 0)
           continue;
         std::vector<double> mu;
-        Vector<double>      z = multiplier_influence(peak_pair, mu);
-        const double        length = contact_pairs.rows[peak_pair].length;
+        // The goal: the mean pressure over the peak pair and its
+        // neighbours (the active pairs of the interface within 1.01 times
+        // the distance to the nearest one), a point value regularised over
+        // about two slave spacings, whose influence the strain recovery
+        // resolves (Becker and Rannacher's regularised point values).
+        const Point<dim> &centre = contact_pairs.points[peak_pair].position;
+        double            nearest = std::numeric_limits<double>::max();
+        for (unsigned int q = 0; q < contact_pairs.size(); ++q)
+          if (q != unsigned(peak_pair) && contact_pairs.rows[q].interface == i &&
+              contact_solution.active[q])
+            nearest = std::min(nearest,
+                               contact_pairs.points[q].position.distance(centre));
+        std::vector<unsigned int> patch;
+        double                    length = 0;
+        for (unsigned int q = 0; q < contact_pairs.size(); ++q)
+          if (contact_pairs.rows[q].interface == i && contact_solution.active[q] &&
+              (q == unsigned(peak_pair) ||
+               contact_pairs.points[q].position.distance(centre) <=
+                 1.01 * nearest))
+            {
+              patch.push_back(q);
+              length += contact_pairs.rows[q].length;
+            }
+        Vector<double>      z = multiplier_influence(patch, mu);
         z /= length;
         std::vector<SurfaceTraction<dim>> tractions_z = tractions_u;
         for (unsigned int q = 0; q < contact_pairs.size(); ++q)
@@ -139,10 +165,10 @@ namespace knee_contact
 
 
   template Vector<double>
-  ContactProblem<2>::multiplier_influence(const unsigned int,
+  ContactProblem<2>::multiplier_influence(const std::vector<unsigned int> &,
                                           std::vector<double> &);
   template Vector<double>
-  ContactProblem<3>::multiplier_influence(const unsigned int,
+  ContactProblem<3>::multiplier_influence(const std::vector<unsigned int> &,
                                           std::vector<double> &);
   template void
   ContactProblem<2>::estimate_pressure_errors(const Results<2> &, const bool);

@@ -84,7 +84,7 @@ namespace
       {
         const unsigned int  p = held[k];
         std::vector<double> mu;
-        const Vector<double> z = problem.multiplier_influence(p, mu);
+        const Vector<double> z = problem.multiplier_influence({p}, mu);
         // The loop's solution must be untouched (the gap is restored).
         AssertThrow(problem.contact().lambda[p] == lambda[p],
                     ExcInternalError());

@@ -169,7 +169,8 @@ namespace knee_contact
      * gaps are restored after). @p mu receives the multipliers of z.
      */
     Vector<double>
-    multiplier_influence(const unsigned int p, std::vector<double> &mu);
+    multiplier_influence(const std::vector<unsigned int> &pairs,
+                         std::vector<double>             &mu);
 
   private:
     /** The parts without a scene: for read_counts() and print_parameters(). */
