@@ -61,8 +61,10 @@ namespace knee_contact
 
   template <int dim>
   void
-  ContactProblem<dim>::estimate_pressure_errors(const Results<dim> &results,
-                                                const bool          uniform)
+  ContactProblem<dim>::estimate_pressure_errors(
+    const Results<dim>                         &results,
+    const bool                                  uniform,
+    const std::map<std::string, ErrorEstimate> &previous)
   {
     goal_indicators.clear();
     if (!contact_system || !contact_pairs.tangential.empty() ||
@@ -129,9 +131,12 @@ namespace knee_contact
         ErrorEstimate goal;
         goal.value = peak;
         // J(u) - J(u_h) ~ the product: its sign says which side the
-        // exact value lies on.
+        // exact value lies on. The safety factor 1.5, measured: |product|
+        // was 0.70 to 1.3 of the true error on the adaptive knees and
+        // Hertz after two cycles (Roache's 1.25 left the knee's and the
+        // gait case's third mesh outside, at 0.87 and 0.89).
         goal.extrapolated = peak + estimate.product;
-        goal.error        = 1.25 * std::abs(estimate.product);
+        goal.error        = 1.5 * std::abs(estimate.product);
         goal.asymptotic   = true;
         goal.basis =
           "goal-oriented: the peak pair's influence and strain recovery";
@@ -146,6 +151,19 @@ namespace knee_contact
             goal.basis      = "the larger of the goal-oriented bar and the "
                          "uniform sequence's (" +
                          sequence->second.basis + ")";
+          }
+        const auto before = previous.find(name);
+        if (before != previous.end() && std::isfinite(before->second.error))
+          {
+            const double change = std::abs(peak - before->second.value);
+            if (change > goal.error + before->second.error)
+              {
+                goal.error      = std::max(goal.error, change);
+                goal.asymptotic = false;
+                goal.basis += "; it changed by more than both meshes' bars "
+                              "allow since the last mesh: not converging "
+                              "there, the bar is at least that change";
+              }
           }
         error_estimates[name] = goal;
         goal_indicators[name] = std::move(estimate.indicators);
@@ -171,7 +189,13 @@ namespace knee_contact
   ContactProblem<3>::multiplier_influence(const std::vector<unsigned int> &,
                                           std::vector<double> &);
   template void
-  ContactProblem<2>::estimate_pressure_errors(const Results<2> &, const bool);
+  ContactProblem<2>::estimate_pressure_errors(
+    const Results<2> &,
+    const bool,
+    const std::map<std::string, ErrorEstimate> &);
   template void
-  ContactProblem<3>::estimate_pressure_errors(const Results<3> &, const bool);
+  ContactProblem<3>::estimate_pressure_errors(
+    const Results<3> &,
+    const bool,
+    const std::map<std::string, ErrorEstimate> &);
 } // namespace knee_contact

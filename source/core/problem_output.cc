@@ -186,7 +186,7 @@ namespace knee_contact
           error_estimates["energy"] = recovered_energy_estimate(
             results.energy,
             recovered_energy_error(dof_handler, displacement, materials));
-          estimate_pressure_errors(results, false);
+          estimate_pressure_errors(results, false, {});
         }
         print_results(results);
         const Errors errors = verification.compute_errors(

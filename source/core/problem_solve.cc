@@ -131,6 +131,11 @@ namespace knee_contact
             }
           cycles.push_back(record.quantities);
           n_dofs.push_back(record.n_dofs);
+          // The previous mesh's bars (its goal-oriented ones are checked
+          // against the change since).
+          const std::map<std::string, ErrorEstimate> previous =
+            records.empty() ? std::map<std::string, ErrorEstimate>()
+                            : error_estimates;
           error_estimates = estimate_errors(cycles, n_dofs, dim);
           // The energy's bar from this mesh alone: strain recovery, with
           // Roache's safety factor 1.25 (measured effectivity of eta^2 on
@@ -147,7 +152,8 @@ namespace knee_contact
             TimerOutput::Scope scope(timer, "error estimate");
             Timer              clock;
             estimate_pressure_errors(results,
-                                     strategy == Refinement::Strategy::global);
+                                     strategy == Refinement::Strategy::global,
+                                     previous);
             record.wall_time["error estimate"] += clock.wall_time();
             record.total_time += clock.wall_time();
           }
@@ -184,7 +190,13 @@ namespace knee_contact
                       << target.value << " +- " << target.error << " ("
                       << relative << " relative, " << target.basis
                       << "), target " << refinement.target_error;
-            if (std::isfinite(relative) && relative <= refinement.target_error)
+            // Reached only with a bar a second mesh has checked (a bar
+            // from one mesh does not see the error of curved edges on a
+            // coarse mesh: the two rings' first mesh, 180 dofs, has a
+            // goal-oriented bar of 3 % beside a true error of 116 %) and
+            // that is not flagged.
+            if (records.size() >= 2 && target.asymptotic &&
+                std::isfinite(relative) && relative <= refinement.target_error)
               {
                 std::cout << ": reached with " << record.n_dofs << " dofs in "
                           << time << " s" << std::endl;

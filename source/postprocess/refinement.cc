@@ -62,7 +62,10 @@ namespace knee_contact
       "0: off. Else the relative error (error bar / value) at which the "
       "run stops refining: it refines by Strategy (global or adaptive) "
       "until the error bar of 'Target quantity' is below this fraction of "
-      "its value, at most Number of cycles (global) or Number of adaptive "
+      "its value (from the second mesh on, a bar not flagged as outside "
+      "its assumptions; a peak pressure's target refines adaptively by that "
+      "pressure's own goal-oriented indicator), at most Number of cycles "
+      "(global) or Number of adaptive "
       "cycles (adaptive) meshes, and reports the value with its error bar, "
       "the DoFs and the time.",
       Patterns::Double(0, 1));

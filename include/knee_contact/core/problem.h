@@ -297,14 +297,21 @@ namespace knee_contact
      * The goal-oriented error bars of each interface's peak pressure
      * (frictionless contact): the influence of the peak pair's
      * multiplier (multiplier_influence()) weights the recovered strain
-     * errors (recovered_error_product()); bar 1.25 |estimate|. Where
+     * errors (recovered_error_product()); bar 1.5 |estimate|. Where
      * error_estimates already holds a bar from a uniformly refined
      * sequence (@p uniform), the larger of the two is kept: the
      * recovery does not see the error of curved boundaries approximated by
-     * straight edges, the sequence does. Fills goal_indicators.
+     * straight edges, the sequence does. Where the value changed since
+     * the previous mesh by more than both meshes' bars allow (@p previous:
+     * that mesh's estimates), the bars are not consistent with the
+     * refinement (a pressure that does not converge there): the bar is at
+     * least that change, flagged. Fills goal_indicators.
      */
     void
-    estimate_pressure_errors(const Results<dim> &results, const bool uniform);
+    estimate_pressure_errors(
+      const Results<dim>                         &results,
+      const bool                                  uniform,
+      const std::map<std::string, ErrorEstimate> &previous);
 
     /**
      * In target mode for a peak pressure: that pressure's goal indicator
