@@ -77,8 +77,12 @@ namespace knee_contact
       tractions_u[q] = {contact_pairs.points[q].slave_dofs[0],
                         contact_pairs.points[q].normal,
                         results.pressure[q]};
-    std::string overall;
-    double      overall_peak = 0;
+    const RecoveredStrain<dim> recovered_u(dof_handler,
+                                           displacement,
+                                           materials,
+                                           tractions_u);
+    std::string                overall;
+    double                     overall_peak = 0;
     for (unsigned int i = 0; i < results.interfaces.size(); ++i)
       {
         // The interface's peak pair: J = lambda_p / length_p.
@@ -123,8 +127,12 @@ namespace knee_contact
         for (unsigned int q = 0; q < contact_pairs.size(); ++q)
           tractions_z[q].pressure =
             mu[q] / length / contact_pairs.rows[q].length;
-        RecoveredProduct estimate = recovered_error_product(
-          dof_handler, displacement, z, materials, tractions_u, tractions_z, true);
+        const RecoveredStrain<dim> recovered_z(dof_handler,
+                                               z,
+                                               materials,
+                                               tractions_z);
+        RecoveredProduct           estimate = recovered_error_product(
+          dof_handler, displacement, recovered_u, z, recovered_z, materials, true);
 
         const std::string name =
           "interface " + results.interfaces[i].name + ": peak pressure";

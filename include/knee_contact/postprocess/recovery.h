@@ -3,12 +3,14 @@
 
 #include <knee_contact/physics/materials.h>
 
+#include <deal.II/base/symmetric_tensor.h>
 #include <deal.II/base/tensor.h>
 
 #include <deal.II/lac/vector.h>
 
 #include <deal.II/dofs/dof_handler.h>
 
+#include <utility>
 #include <vector>
 
 namespace knee_contact
@@ -63,15 +65,46 @@ namespace knee_contact
     Vector<float> indicators;
   };
 
+  /**
+   * The recovered strain of one displacement at each (vertex, material):
+   * the average described above, with the contact tractions of
+   * @p tractions imposed. Stored by vertex index (a vertex has one entry
+   * per material that meets there), so that one recovery serves several
+   * products.
+   */
+  template <int dim>
+  class RecoveredStrain
+  {
+  public:
+    RecoveredStrain(const DoFHandler<dim>                   &dof_handler,
+                    const Vector<double>                    &solution,
+                    const Materials<dim>                    &materials,
+                    const std::vector<SurfaceTraction<dim>> &tractions = {});
+
+    /** The recovered strain at @p vertex in @p material. */
+    const SymmetricTensor<2, dim> &
+    operator()(const unsigned int       vertex,
+               const types::material_id material) const;
+
+  private:
+    std::vector<
+      std::vector<std::pair<types::material_id, SymmetricTensor<2, dim>>>>
+      averages;
+  };
+
+  /**
+   * The products above of u and z from their recoveries @p recovered_u
+   * and @p recovered_z.
+   */
   template <int dim>
   RecoveredProduct
-  recovered_error_product(const DoFHandler<dim>                   &dof_handler,
-                          const Vector<double>                    &u,
-                          const Vector<double>                    &z,
-                          const Materials<dim>                    &materials,
-                          const std::vector<SurfaceTraction<dim>> &tractions_u,
-                          const std::vector<SurfaceTraction<dim>> &tractions_z,
-                          const bool with_indicators = false);
+  recovered_error_product(const DoFHandler<dim>      &dof_handler,
+                          const Vector<double>       &u,
+                          const RecoveredStrain<dim> &recovered_u,
+                          const Vector<double>       &z,
+                          const RecoveredStrain<dim> &recovered_z,
+                          const Materials<dim>       &materials,
+                          const bool                  with_indicators = false);
 
   /**
    * The Zienkiewicz-Zhu estimate eta^2 of a(u - u_h, u - u_h): the
