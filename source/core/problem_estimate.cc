@@ -103,17 +103,20 @@ namespace knee_contact
         // the distance to the nearest one), a point value regularised over
         // about two slave spacings, whose influence the strain recovery
         // resolves (Becker and Rannacher's regularised point values).
-        const Point<dim> &centre = contact_pairs.points[peak_pair].position;
+        const Point<dim> &centre  = contact_pairs.points[peak_pair].position;
         double            nearest = std::numeric_limits<double>::max();
         for (unsigned int q = 0; q < contact_pairs.size(); ++q)
-          if (q != unsigned(peak_pair) && contact_pairs.rows[q].interface == i &&
+          if (q != unsigned(peak_pair) &&
+              contact_pairs.rows[q].interface == i &&
               contact_solution.active[q])
-            nearest = std::min(nearest,
-                               contact_pairs.points[q].position.distance(centre));
+            nearest =
+              std::min(nearest,
+                       contact_pairs.points[q].position.distance(centre));
         std::vector<unsigned int> patch;
         double                    length = 0;
         for (unsigned int q = 0; q < contact_pairs.size(); ++q)
-          if (contact_pairs.rows[q].interface == i && contact_solution.active[q] &&
+          if (contact_pairs.rows[q].interface == i &&
+              contact_solution.active[q] &&
               (q == unsigned(peak_pair) ||
                contact_pairs.points[q].position.distance(centre) <=
                  1.01 * nearest))
@@ -121,7 +124,7 @@ namespace knee_contact
               patch.push_back(q);
               length += contact_pairs.rows[q].length;
             }
-        Vector<double>      z = multiplier_influence(patch, mu);
+        Vector<double> z = multiplier_influence(patch, mu);
         z /= length;
         std::vector<SurfaceTraction<dim>> tractions_z = tractions_u;
         for (unsigned int q = 0; q < contact_pairs.size(); ++q)
@@ -131,8 +134,13 @@ namespace knee_contact
                                                z,
                                                materials,
                                                tractions_z);
-        RecoveredProduct           estimate = recovered_error_product(
-          dof_handler, displacement, recovered_u, z, recovered_z, materials, true);
+        RecoveredProduct estimate = recovered_error_product(dof_handler,
+                                                            displacement,
+                                                            recovered_u,
+                                                            z,
+                                                            recovered_z,
+                                                            materials,
+                                                            true);
 
         const std::string name =
           "interface " + results.interfaces[i].name + ": peak pressure";
@@ -157,7 +165,7 @@ namespace knee_contact
             goal.asymptotic = sequence->second.asymptotic;
             goal.order      = sequence->second.order;
             goal.basis      = "the larger of the goal-oriented bar and the "
-                         "uniform sequence's (" +
+                              "uniform sequence's (" +
                          sequence->second.basis + ")";
           }
         const auto before = previous.find(name);

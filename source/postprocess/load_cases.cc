@@ -166,8 +166,8 @@ namespace knee_contact
         if (with_times)
           out << std::scientific << std::setprecision(2) << std::setw(18)
               << r.energy_error << std::setw(15) << r.peak_pressure_error
-              << std::defaultfloat << std::setprecision(3)
-              << std::setw(11) << r.solve_time;
+              << std::defaultfloat << std::setprecision(3) << std::setw(11)
+              << r.solve_time;
         out << (r.converged ? "" : "  NOT converged") << '\n';
       }
     out << std::flush;

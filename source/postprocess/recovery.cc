@@ -24,7 +24,7 @@ namespace knee_contact
           {
             // e_ij = e_ji = 1/2 off the diagonal: C : e = C_..ij.
             SymmetricTensor<2, dim> unit;
-            unit[i][j] = (i == j ? 1. : 0.5);
+            unit[i][j]                           = (i == j ? 1. : 0.5);
             const SymmetricTensor<2, dim> stress = material.stress(unit);
             for (unsigned int k = 0; k < dim; ++k)
               for (unsigned int l = k; l < dim; ++l)
@@ -47,13 +47,14 @@ namespace knee_contact
     // The strain of the solution at the vertices of every cell (the nodal
     // rule's points are the vertices in deal.II's order), summed per
     // (vertex, material).
-    const FiniteElement<dim> &fe         = dof_handler.get_fe();
-    const ReferenceCell       kind       = fe.reference_cell();
-    const unsigned int        n_vertices = kind.n_vertices();
+    const FiniteElement<dim>              &fe         = dof_handler.get_fe();
+    const ReferenceCell                    kind       = fe.reference_cell();
+    const unsigned int                     n_vertices = kind.n_vertices();
     std::vector<std::vector<unsigned int>> counts(averages.size());
-    std::vector<unsigned int>              vertex_of_dof(
-      tractions.empty() ? 0 : dof_handler.n_dofs(),
-      numbers::invalid_unsigned_int);
+    std::vector<unsigned int>              vertex_of_dof(tractions.empty()
+                                              ? 0
+                                              : dof_handler.n_dofs(),
+                                            numbers::invalid_unsigned_int);
     FEValues<dim>                        nodal(elements::mapping(dof_handler),
                         fe,
                         kind.template get_nodal_type_quadrature<dim>(),
@@ -63,8 +64,7 @@ namespace knee_contact
     for (const auto &cell : dof_handler.active_cell_iterators())
       {
         nodal.reinit(cell);
-        nodal[displacement].get_function_symmetric_gradients(solution,
-                                                             strains);
+        nodal[displacement].get_function_symmetric_gradients(solution, strains);
         for (unsigned int v = 0; v < n_vertices; ++v)
           {
             const unsigned int vertex = cell->vertex_index(v);
@@ -142,10 +142,10 @@ namespace knee_contact
                           const Materials<dim>       &materials,
                           const bool                  with_indicators)
   {
-    const FiniteElement<dim> &fe = dof_handler.get_fe();
+    const FiniteElement<dim> &fe         = dof_handler.get_fe();
     const unsigned int        n_vertices = fe.reference_cell().n_vertices();
     const FEValuesExtractors::Vector displacement(0);
-    const bool                       same = &u == &z && &recovered_u == &recovered_z;
+    const bool same = &u == &z && &recovered_u == &recovered_z;
 
     FEValues<dim>      fe_values(elements::mapping(dof_handler),
                             fe,
@@ -170,7 +170,8 @@ namespace knee_contact
         const Material<dim> &material = materials[cell->material_id()];
         for (unsigned int v = 0; v < n_vertices; ++v)
           {
-            vertex_u[v] = recovered_u(cell->vertex_index(v), cell->material_id());
+            vertex_u[v] =
+              recovered_u(cell->vertex_index(v), cell->material_id());
             if (!same)
               vertex_z[v] =
                 recovered_z(cell->vertex_index(v), cell->material_id());
@@ -215,29 +216,25 @@ namespace knee_contact
                          const Materials<dim>  &materials)
   {
     const RecoveredStrain<dim> recovered(dof_handler, solution, materials);
-    return recovered_error_product(dof_handler,
-                                   solution,
-                                   recovered,
-                                   solution,
-                                   recovered,
-                                   materials)
+    return recovered_error_product(
+             dof_handler, solution, recovered, solution, recovered, materials)
       .eta_u_squared;
   }
 
 
 
-#define KNEE_CONTACT_INSTANTIATE(dim)                                        \
-  template class RecoveredStrain<dim>;                                       \
-  template RecoveredProduct recovered_error_product(                         \
-    const DoFHandler<dim> &,                                                 \
-    const Vector<double> &,                                                  \
-    const RecoveredStrain<dim> &,                                            \
-    const Vector<double> &,                                                  \
-    const RecoveredStrain<dim> &,                                            \
-    const Materials<dim> &,                                                  \
-    const bool);                                                             \
-  template double recovered_energy_error(const DoFHandler<dim> &,            \
-                                         const Vector<double> &,             \
+#define KNEE_CONTACT_INSTANTIATE(dim)                             \
+  template class RecoveredStrain<dim>;                            \
+  template RecoveredProduct recovered_error_product(              \
+    const DoFHandler<dim> &,                                      \
+    const Vector<double> &,                                       \
+    const RecoveredStrain<dim> &,                                 \
+    const Vector<double> &,                                       \
+    const RecoveredStrain<dim> &,                                 \
+    const Materials<dim> &,                                       \
+    const bool);                                                  \
+  template double recovered_energy_error(const DoFHandler<dim> &, \
+                                         const Vector<double> &,  \
                                          const Materials<dim> &);
   KNEE_CONTACT_INSTANTIATE(2)
   KNEE_CONTACT_INSTANTIATE(3)

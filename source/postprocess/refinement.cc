@@ -113,8 +113,7 @@ namespace knee_contact
         return;
       }
     Vector<float> kelly(triangulation.n_active_cells());
-    if (goal != nullptr && goal->size() == kelly.size() &&
-        goal->l1_norm() > 0)
+    if (goal != nullptr && goal->size() == kelly.size() && goal->l1_norm() > 0)
       kelly = *goal;
     else
       {

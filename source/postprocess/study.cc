@@ -30,13 +30,13 @@ namespace knee_contact
     effectivities(const CycleRecord &r)
     {
       const double true_energy =
-        std::isfinite(r.errors.energy_reference_relative) ?
-          r.errors.energy_reference_relative :
-          r.errors.energy_relative * r.errors.energy_relative;
+        std::isfinite(r.errors.energy_reference_relative)
+          ? r.errors.energy_reference_relative
+          : r.errors.energy_relative * r.errors.energy_relative;
       const auto ratio = [](const double estimate, const double error) {
-        return std::isfinite(estimate) && std::isfinite(error) && error > 0 ?
-                 estimate / error :
-                 std::numeric_limits<double>::quiet_NaN();
+        return std::isfinite(estimate) && std::isfinite(error) && error > 0
+                 ? estimate / error
+                 : std::numeric_limits<double>::quiet_NaN();
       };
       return {ratio(r.estimated_peak_pressure_error,
                     r.errors.peak_pressure_relative),
@@ -94,10 +94,9 @@ namespace knee_contact
                     "peak effectivity",
                     peak,
                     r.n_pairs > 0 &&
-                      std::isfinite(records.back().errors.peak_pressure_relative)},
-                  {"energy effectivity",
-                   energy,
-                   std::isfinite(first.second)}})
+                      std::isfinite(
+                        records.back().errors.peak_pressure_relative)},
+                  {"energy effectivity", energy, std::isfinite(first.second)}})
               if (shown)
                 {
                   table.add_value(name, value);
@@ -186,8 +185,7 @@ namespace knee_contact
         out << ',' << r.estimated_peak_pressure_error << ','
             << r.estimated_energy_error << ','
             << r.recovered_energy_error / std::abs(r.energy) << ','
-            << effectivities(r).first << ',' << effectivities(r).second
-            << '\n';
+            << effectivities(r).first << ',' << effectivities(r).second << '\n';
       }
   }
 } // namespace knee_contact

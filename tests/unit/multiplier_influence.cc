@@ -38,11 +38,11 @@ namespace
       problem.run();
       std::cout.rdbuf(terminal);
     }
-    const auto &K      = problem.matrix();
-    const auto &f      = problem.rhs();
-    const auto &pairs  = problem.pairs();
-    const auto &active = problem.contact().active;
-    const auto &lambda = problem.contact().lambda;
+    const auto        &K      = problem.matrix();
+    const auto        &f      = problem.rhs();
+    const auto        &pairs  = problem.pairs();
+    const auto        &active = problem.contact().active;
+    const auto        &lambda = problem.contact().lambda;
     const FreeDofs     reduced(K, f, problem.base_constraints());
     const unsigned int n = K.m(), n_free = reduced.n_free;
 
@@ -77,13 +77,12 @@ namespace
     kkt.solve(change);
 
     bool ok = true;
-    std::cout << scene << ", " << solver_path_name(path) << ": "
-              << held.size() << " active of " << pairs.size() << " pairs"
-              << std::endl;
+    std::cout << scene << ", " << solver_path_name(path) << ": " << held.size()
+              << " active of " << pairs.size() << " pairs" << std::endl;
     for (unsigned int k = 0; k < held.size(); ++k)
       {
-        const unsigned int  p = held[k];
-        std::vector<double> mu;
+        const unsigned int   p = held[k];
+        std::vector<double>  mu;
         const Vector<double> z = problem.multiplier_influence({p}, mu);
         // The loop's solution must be untouched (the gap is restored).
         AssertThrow(problem.contact().lambda[p] == lambda[p],
@@ -103,8 +102,8 @@ namespace
         for (unsigned int j = 0; j < held.size(); ++j)
           {
             mu_scale = std::max(mu_scale, std::abs(dense(n_free + j)));
-            mu_error = std::max(mu_error,
-                                std::abs(mu[held[j]] - dense(n_free + j)));
+            mu_error =
+              std::max(mu_error, std::abs(mu[held[j]] - dense(n_free + j)));
           }
         mu_error /= mu_scale;
         // lambda_p's change under dd: dense solve vs z . dd.

@@ -5,9 +5,9 @@
 
 #include <deal.II/base/parameter_handler.h>
 
+#include <limits>
 #include <ostream>
 #include <string>
-#include <limits>
 #include <vector>
 
 namespace knee_contact
