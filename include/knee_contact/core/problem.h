@@ -305,9 +305,12 @@ namespace knee_contact
      * the previous mesh by more than both meshes' bars allow (@p previous:
      * that mesh's estimates), the bars are not consistent with the
      * refinement (a pressure that does not converge there): the bar is at
-     * least that change, flagged. Fills goal_indicators.
+     * least that change, flagged. Fills goal_indicators. Returns the
+     * energy's eta^2 of the same strain recovery (recovered_energy_error()
+     * with the contact tractions imposed; without contact rows or with
+     * friction the plain recovery).
      */
-    void
+    double
     estimate_pressure_errors(
       const Results<dim>                         &results,
       const bool                                  uniform,
