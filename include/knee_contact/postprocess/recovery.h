@@ -36,8 +36,8 @@ namespace knee_contact
    * Strain recovery of two displacements u and z on one mesh. Each strain
    * is averaged at each vertex over the cells of one material that share
    * it (so that a bonded material junction, where the strain jumps, is not
-   * smoothed over); at a contact vertex listed in @p tractions_u
-   * (@p tractions_z) the average's normal stress is replaced by the known
+   * smoothed over); at a contact vertex given a SurfaceTraction (see
+   * RecoveredStrain) the average's normal stress is replaced by the known
    * contact traction (sigma* n = -p n: the recovered stress satisfies the
    * boundary condition the discrete multiplier gives); the averages are
    * interpolated by the cells' own linear shape functions. With e_u =
