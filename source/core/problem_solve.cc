@@ -143,8 +143,10 @@ namespace knee_contact
           {
             TimerOutput::Scope scope(timer, "error estimate");
             Timer              clock;
-            record.recovered_energy_error = estimate_pressure_errors(
-              results, strategy == Refinement::Strategy::global, previous);
+            record.recovered_energy_error =
+              estimate_pressure_errors(results,
+                                       strategy == Refinement::Strategy::global,
+                                       previous);
             error_estimates["energy"] =
               recovered_energy_estimate(record.energy,
                                         record.recovered_energy_error);
