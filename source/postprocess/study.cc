@@ -166,6 +166,7 @@ namespace knee_contact
     out << estimate_columns << '\n' << std::setprecision(10);
     for (const CycleRecord &r : records)
       {
+        const auto [peak_effectivity, energy_effectivity] = effectivities(r);
         out << r.strategy << ',' << r.cycle << ',' << r.n_cells << ','
             << r.n_dofs << ',' << r.n_pairs << ',' << r.n_iterations << ','
             << r.peak_pressure << ',' << r.energy;
@@ -185,7 +186,7 @@ namespace knee_contact
         out << ',' << r.estimated_peak_pressure_error << ','
             << r.estimated_energy_error << ','
             << r.recovered_energy_error / std::abs(r.energy) << ','
-            << effectivities(r).first << ',' << effectivities(r).second << '\n';
+            << peak_effectivity << ',' << energy_effectivity << '\n';
       }
   }
 } // namespace knee_contact
