@@ -8,6 +8,7 @@
 #include <deal.II/grid/grid_tools.h>
 #include <deal.II/grid/manifold_lib.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdlib>
@@ -205,6 +206,17 @@ namespace knee_contact
                                  ") needs x1 > x0 and y1 > y0"));
           r.n_x          = std::get<4>(entry);
           r.n_y          = std::get<5>(entry);
+          AssertThrow(std::isfinite(r.lower[0]) && std::isfinite(r.lower[1]) &&
+                        std::isfinite(r.upper[0]) &&
+                        std::isfinite(r.upper[1]) &&
+                        std::isfinite(r.upper[0] - r.lower[0]) &&
+                        std::isfinite(r.upper[1] - r.lower[1]),
+                      ExcMessage("Mesh/Rectangles: a rectangle from (" +
+                                 std::to_string(r.lower[0]) + ", " +
+                                 std::to_string(r.lower[1]) + ") to (" +
+                                 std::to_string(r.upper[0]) + ", " +
+                                 std::to_string(r.upper[1]) +
+                                 ") is not finite"));
           r.material_id  = static_cast<types::material_id>(std::get<6>(entry));
           r.group        = std::get<7>(entry);
           r.boundary_ids = {{std::get<8>(entry),
@@ -213,6 +225,30 @@ namespace knee_contact
                              std::get<11>(entry)}};
           rectangles.push_back(r);
         }
+    // make_rectangles_2d() finds shared vertices by their coordinates
+    // rounded to 1e-6 of the smallest cell size in a long: no coordinate
+    // may lie 1e12 of those cell sizes from the origin (-1e308 passes
+    // Patterns::Double but overflows the rounding).
+    double smallest_cell = std::numeric_limits<double>::max(), extent = 0;
+    for (const Rectangle &r : rectangles)
+      {
+        smallest_cell = std::min({smallest_cell,
+                                  (r.upper[0] - r.lower[0]) / r.n_x,
+                                  (r.upper[1] - r.lower[1]) / r.n_y});
+        for (unsigned int d = 0; d < 2; ++d)
+          extent = std::max({extent,
+                             std::abs(r.lower[d]),
+                             std::abs(r.upper[d])});
+      }
+    if (!(extent < 1e12 * smallest_cell))
+      {
+        std::ostringstream message;
+        message << "Mesh/Rectangles: coordinates up to " << extent
+                << " m with cells of " << smallest_cell
+                << " m: the cells must be larger than 1e-12 of the largest "
+                   "coordinate";
+        AssertThrow(false, ExcMessage(message.str()));
+      }
 
     for (const auto &[id, centre] : entries.circular_boundaries)
       {

@@ -398,12 +398,19 @@ namespace knee_contact
     for (const auto &cell : triangulation.active_cell_iterators())
       {
         const Point<2> centre = cell->center();
-        const auto     rect   = *std::find_if(
+        const auto     found  = std::find_if(
           rectangles.begin(), rectangles.end(), [&](const Rectangle &r) {
             return r.material_id == cell->material_id() &&
                    centre[0] > r.lower[0] && centre[0] < r.upper[0] &&
                    centre[1] > r.lower[1] && centre[1] < r.upper[1];
           });
+        // Only a mesh whose vertices were merged wrongly has such a cell.
+        AssertThrow(found != rectangles.end(),
+                    ExcMessage("Mesh/Rectangles: the cell at (" +
+                               std::to_string(centre[0]) + ", " +
+                               std::to_string(centre[1]) +
+                               ") lies inside none of the rectangles"));
+        const Rectangle &rect = *found;
         const double tol = 1e-8 * cell->diameter();
         for (const unsigned int f : cell->face_indices())
           if (cell->face(f)->at_boundary())
