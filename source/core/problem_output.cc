@@ -183,7 +183,7 @@ namespace knee_contact
         {
           TimerOutput::Scope scope(timer, "error estimate");
           const double       eta_squared =
-            estimate_pressure_errors(results, false, {});
+            estimate_mesh_errors(results, false, {});
           error_estimates["energy"] =
             recovered_energy_estimate(results.energy, eta_squared);
         }
@@ -316,19 +316,19 @@ namespace knee_contact
     // What the bars rest on, once.
     if (!output_writer.test_mode() && !error_estimates.empty())
       {
-        const auto &energy = error_estimates.at("energy");
-        out << "  error bars (+-): estimated discretisation errors from the "
-               "run's meshes, "
-            << energy.basis << " for the energy";
+        out << "  error bars (+-): estimated discretisation errors of this "
+               "mesh (summary.json's error_estimates says how each was "
+               "made): strain recovery for the energy and the stress "
+               "extremes, goal-oriented for frictionless peak pressures and "
+               "forces, one slave spacing per contact edge for the lengths, "
+               "else from the run's meshes";
         bool flagged = false;
         for (const auto &[name, estimate] : error_estimates)
           flagged =
             flagged || (std::isfinite(estimate.error) && !estimate.asymptotic);
         if (flagged)
-          out << "; (!): not in the asymptotic range, a conservative bar";
-        if (!std::isfinite(energy.error))
-          out << " (Refinement/Number of cycles >= 2 gives bars; >= 3 "
-                 "observed orders)";
+          out << "; (!): not in the asymptotic range or not converging, a "
+                 "conservative bar";
         out << "\n";
       }
     if (!contact_pairs.empty())

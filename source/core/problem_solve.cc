@@ -144,7 +144,7 @@ namespace knee_contact
             TimerOutput::Scope scope(timer, "error estimate");
             Timer              clock;
             record.recovered_energy_error =
-              estimate_pressure_errors(results,
+              estimate_mesh_errors(results,
                                        strategy == Refinement::Strategy::global,
                                        previous);
             error_estimates["energy"] =

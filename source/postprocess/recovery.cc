@@ -3,6 +3,7 @@
 
 #include <deal.II/fe/fe_values.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <utility>
@@ -42,18 +43,44 @@ namespace knee_contact
     const Vector<double>                    &solution,
     const Materials<dim>                    &materials,
     const std::vector<SurfaceTraction<dim>> &tractions)
-    : averages(dof_handler.get_triangulation().n_vertices())
   {
-    // The strain of the solution at the vertices of every cell (the nodal
+    *this = std::move(of(dof_handler, {&solution}, materials, {tractions})[0]);
+  }
+
+
+
+  template <int dim>
+  std::vector<RecoveredStrain<dim>>
+  RecoveredStrain<dim>::of(
+    const DoFHandler<dim>                                &dof_handler,
+    const std::vector<const Vector<double> *>            &solutions,
+    const Materials<dim>                                 &materials,
+    const std::vector<std::vector<SurfaceTraction<dim>>> &tractions)
+  {
+    AssertThrow(tractions.size() == solutions.size(), ExcInternalError());
+    const unsigned int n_mesh_vertices =
+      dof_handler.get_triangulation().n_vertices();
+    // (The default constructor is private: built here, moved into place.)
+    std::vector<RecoveredStrain<dim>> recovered;
+    for (unsigned int i = 0; i < solutions.size(); ++i)
+      {
+        recovered.push_back(RecoveredStrain<dim>());
+        recovered.back().averages.resize(n_mesh_vertices);
+      }
+    // The strain of each solution at the vertices of every cell (the nodal
     // rule's points are the vertices in deal.II's order), summed per
-    // (vertex, material).
+    // (vertex, material); the (vertex, material) slots are the same for
+    // every solution.
     const FiniteElement<dim>              &fe         = dof_handler.get_fe();
     const ReferenceCell                    kind       = fe.reference_cell();
     const unsigned int                     n_vertices = kind.n_vertices();
-    std::vector<std::vector<unsigned int>> counts(averages.size());
-    std::vector<unsigned int>              vertex_of_dof(tractions.empty()
-                                              ? 0
-                                              : dof_handler.n_dofs(),
+    std::vector<std::vector<unsigned int>> counts(n_mesh_vertices);
+    bool                                   any_traction = false;
+    for (const auto &t : tractions)
+      any_traction = any_traction || !t.empty();
+    std::vector<unsigned int>            vertex_of_dof(any_traction ?
+                                                         dof_handler.n_dofs() :
+                                                         0,
                                             numbers::invalid_unsigned_int);
     FEValues<dim>                        nodal(elements::mapping(dof_handler),
                         fe,
@@ -61,33 +88,74 @@ namespace knee_contact
                         update_gradients);
     std::vector<SymmetricTensor<2, dim>> strains(n_vertices);
     const FEValuesExtractors::Vector     displacement(0);
+    const unsigned int                   n_cell_dofs = fe.n_dofs_per_cell();
+    std::vector<types::global_dof_index> cell_dofs(n_cell_dofs);
+    std::vector<SymmetricTensor<2, dim>> shape_strains(n_cell_dofs *
+                                                       n_vertices);
     for (const auto &cell : dof_handler.active_cell_iterators())
       {
         nodal.reinit(cell);
-        nodal[displacement].get_function_symmetric_gradients(solution, strains);
-        for (unsigned int v = 0; v < n_vertices; ++v)
+        cell->get_dof_indices(cell_dofs);
+        // The shape functions' strains once per cell, for every solution.
+        for (unsigned int j = 0; j < n_cell_dofs; ++j)
+          for (unsigned int v = 0; v < n_vertices; ++v)
+            shape_strains[j * n_vertices + v] =
+              nodal[displacement].symmetric_gradient(j, v);
+        for (unsigned int i = 0; i < solutions.size(); ++i)
           {
-            const unsigned int vertex = cell->vertex_index(v);
-            auto              &here   = averages[vertex];
-            unsigned int       k      = 0;
-            while (k < here.size() && here[k].first != cell->material_id())
-              ++k;
-            if (k == here.size())
+            std::fill(strains.begin(),
+                      strains.end(),
+                      SymmetricTensor<2, dim>());
+            for (unsigned int j = 0; j < n_cell_dofs; ++j)
               {
-                here.emplace_back(cell->material_id(),
-                                  SymmetricTensor<2, dim>());
-                counts[vertex].push_back(0);
+                const double value = (*solutions[i])(cell_dofs[j]);
+                for (unsigned int v = 0; v < n_vertices; ++v)
+                  strains[v] += value * shape_strains[j * n_vertices + v];
               }
-            here[k].second += strains[v];
-            ++counts[vertex][k];
-            if (!tractions.empty())
-              vertex_of_dof[cell->vertex_dof_index(v, 0)] = vertex;
+            for (unsigned int v = 0; v < n_vertices; ++v)
+              {
+                const unsigned int vertex = cell->vertex_index(v);
+                auto              &here   = recovered[i].averages[vertex];
+                unsigned int       k      = 0;
+                while (k < here.size() && here[k].first != cell->material_id())
+                  ++k;
+                if (k == here.size())
+                  {
+                    here.emplace_back(cell->material_id(),
+                                      SymmetricTensor<2, dim>());
+                    if (i == 0)
+                      counts[vertex].push_back(0);
+                  }
+                here[k].second += strains[v];
+                if (i == 0)
+                  {
+                    ++counts[vertex][k];
+                    if (any_traction)
+                      vertex_of_dof[cell->vertex_dof_index(v, 0)] = vertex;
+                  }
+              }
           }
       }
-    for (unsigned int vertex = 0; vertex < averages.size(); ++vertex)
-      for (unsigned int k = 0; k < averages[vertex].size(); ++k)
-        averages[vertex][k].second /= double(counts[vertex][k]);
+    for (unsigned int i = 0; i < solutions.size(); ++i)
+      {
+        for (unsigned int vertex = 0; vertex < n_mesh_vertices; ++vertex)
+          for (unsigned int k = 0; k < counts[vertex].size(); ++k)
+            recovered[i].averages[vertex][k].second /=
+              double(counts[vertex][k]);
+        recovered[i].impose(tractions[i], vertex_of_dof, materials);
+      }
+    return recovered;
+  }
 
+
+
+  template <int dim>
+  void
+  RecoveredStrain<dim>::impose(
+    const std::vector<SurfaceTraction<dim>> &tractions,
+    const std::vector<unsigned int>         &vertex_of_dof,
+    const Materials<dim>                    &materials)
+  {
     // At a contact vertex sigma* = P sigma P - p n (x) n with P = I - n (x)
     // n: the tangential stress of the average stays, the normal traction
     // is the contact's (a slave vertex belongs to one body, one material
@@ -133,6 +201,109 @@ namespace knee_contact
 
 
   template <int dim>
+  std::vector<RecoveredProduct>
+  recovered_error_products(const DoFHandler<dim>             &dof_handler,
+                           const Vector<double>              &u,
+                           const RecoveredStrain<dim>        &recovered_u,
+                           const std::vector<Influence<dim>> &influences,
+                           const Materials<dim>              &materials,
+                           const bool                         with_indicators)
+  {
+    const FiniteElement<dim> &fe         = dof_handler.get_fe();
+    const unsigned int        n_vertices = fe.reference_cell().n_vertices();
+    const FEValuesExtractors::Vector displacement(0);
+    const unsigned int               n_z = influences.size();
+
+    FEValues<dim>      fe_values(elements::mapping(dof_handler),
+                            fe,
+                            elements::cell_quadrature(dof_handler, 2),
+                            update_values | update_gradients |
+                              update_JxW_values);
+    const unsigned int n_q = fe_values.n_quadrature_points;
+    std::vector<SymmetricTensor<2, dim>> strains_u(n_q), vertex_u(n_vertices);
+    std::vector<std::vector<SymmetricTensor<2, dim>>> strains_z(
+      n_z, std::vector<SymmetricTensor<2, dim>>(n_q)),
+      vertex_z(n_z, std::vector<SymmetricTensor<2, dim>>(n_vertices));
+    std::vector<double>           products(n_z);
+    std::vector<RecoveredProduct> result(n_z);
+    double                        eta_u_squared = 0;
+    if (with_indicators)
+      for (auto &r : result)
+        r.indicators.reinit(dof_handler.get_triangulation().n_active_cells());
+    const unsigned int                   n_cell_dofs = fe.n_dofs_per_cell();
+    std::vector<types::global_dof_index> cell_dofs(n_cell_dofs);
+    std::vector<SymmetricTensor<2, dim>> shape_strains(n_cell_dofs * n_q);
+    // The discrete strains of a solution at the points, from the shape
+    // functions' strains computed once per cell.
+    const auto strains_of = [&](const Vector<double>                 &x,
+                                std::vector<SymmetricTensor<2, dim>> &e) {
+      std::fill(e.begin(), e.end(), SymmetricTensor<2, dim>());
+      for (unsigned int j = 0; j < n_cell_dofs; ++j)
+        {
+          const double value = x(cell_dofs[j]);
+          for (unsigned int q = 0; q < n_q; ++q)
+            e[q] += value * shape_strains[j * n_q + q];
+        }
+    };
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      {
+        fe_values.reinit(cell);
+        cell->get_dof_indices(cell_dofs);
+        for (unsigned int j = 0; j < n_cell_dofs; ++j)
+          for (unsigned int q = 0; q < n_q; ++q)
+            shape_strains[j * n_q + q] =
+              fe_values[displacement].symmetric_gradient(j, q);
+        strains_of(u, strains_u);
+        const types::material_id id = cell->material_id();
+        for (unsigned int v = 0; v < n_vertices; ++v)
+          vertex_u[v] = recovered_u(cell->vertex_index(v), id);
+        for (unsigned int i = 0; i < n_z; ++i)
+          {
+            strains_of(*influences[i].z, strains_z[i]);
+            for (unsigned int v = 0; v < n_vertices; ++v)
+              vertex_z[i][v] =
+                (*influences[i].recovered)(cell->vertex_index(v), id);
+          }
+        const Material<dim> &material = materials[id];
+        std::fill(products.begin(), products.end(), 0.);
+        for (unsigned int q = 0; q < n_q; ++q)
+          {
+            // The recovered strains interpolated with the scalar linear
+            // shape function of each vertex (component 0 of the vector
+            // element), minus the discrete ones.
+            SymmetricTensor<2, dim> error_u = -strains_u[q];
+            for (unsigned int v = 0; v < n_vertices; ++v)
+              error_u +=
+                fe_values.shape_value(fe.component_to_system_index(0, v), q) *
+                vertex_u[v];
+            const SymmetricTensor<2, dim> stress_u = material.stress(error_u);
+            eta_u_squared += error_u * stress_u * fe_values.JxW(q);
+            for (unsigned int i = 0; i < n_z; ++i)
+              {
+                SymmetricTensor<2, dim> error_z = -strains_z[i][q];
+                for (unsigned int v = 0; v < n_vertices; ++v)
+                  error_z += fe_values.shape_value(
+                               fe.component_to_system_index(0, v), q) *
+                             vertex_z[i][v];
+                products[i] += error_z * stress_u * fe_values.JxW(q);
+              }
+          }
+        for (unsigned int i = 0; i < n_z; ++i)
+          {
+            result[i].product += products[i];
+            if (with_indicators)
+              result[i].indicators(cell->active_cell_index()) =
+                std::abs(products[i]);
+          }
+      }
+    for (auto &r : result)
+      r.eta_u_squared = eta_u_squared;
+    return result;
+  }
+
+
+
+  template <int dim>
   RecoveredProduct
   recovered_error_product(const DoFHandler<dim>      &dof_handler,
                           const Vector<double>       &u,
@@ -142,69 +313,13 @@ namespace knee_contact
                           const Materials<dim>       &materials,
                           const bool                  with_indicators)
   {
-    const FiniteElement<dim> &fe         = dof_handler.get_fe();
-    const unsigned int        n_vertices = fe.reference_cell().n_vertices();
-    const FEValuesExtractors::Vector displacement(0);
-    const bool same = &u == &z && &recovered_u == &recovered_z;
-
-    FEValues<dim>      fe_values(elements::mapping(dof_handler),
-                            fe,
-                            elements::cell_quadrature(dof_handler, 2),
-                            update_values | update_gradients |
-                              update_JxW_values);
-    const unsigned int n_q = fe_values.n_quadrature_points;
-    std::vector<SymmetricTensor<2, dim>> strains_u(n_q), strains_z(n_q);
-    std::vector<SymmetricTensor<2, dim>> vertex_u(n_vertices),
-      vertex_z(n_vertices);
-    RecoveredProduct result;
-    if (with_indicators)
-      result.indicators.reinit(
-        dof_handler.get_triangulation().n_active_cells());
-    for (const auto &cell : dof_handler.active_cell_iterators())
-      {
-        fe_values.reinit(cell);
-        fe_values[displacement].get_function_symmetric_gradients(u, strains_u);
-        if (!same)
-          fe_values[displacement].get_function_symmetric_gradients(z,
-                                                                   strains_z);
-        const Material<dim> &material = materials[cell->material_id()];
-        for (unsigned int v = 0; v < n_vertices; ++v)
-          {
-            vertex_u[v] =
-              recovered_u(cell->vertex_index(v), cell->material_id());
-            if (!same)
-              vertex_z[v] =
-                recovered_z(cell->vertex_index(v), cell->material_id());
-          }
-        double product = 0;
-        for (unsigned int q = 0; q < n_q; ++q)
-          {
-            // The recovered strains interpolated with the scalar linear
-            // shape function of each vertex (component 0 of the vector
-            // element), minus the discrete ones.
-            SymmetricTensor<2, dim> error_u = -strains_u[q];
-            SymmetricTensor<2, dim> error_z;
-            if (!same)
-              error_z = -strains_z[q];
-            for (unsigned int v = 0; v < n_vertices; ++v)
-              {
-                const double phi =
-                  fe_values.shape_value(fe.component_to_system_index(0, v), q);
-                error_u += phi * vertex_u[v];
-                if (!same)
-                  error_z += phi * vertex_z[v];
-              }
-            if (same)
-              error_z = error_u;
-            const SymmetricTensor<2, dim> stress_u = material.stress(error_u);
-            product += error_z * stress_u * fe_values.JxW(q);
-            result.eta_u_squared += error_u * stress_u * fe_values.JxW(q);
-          }
-        result.product += product;
-        if (with_indicators)
-          result.indicators(cell->active_cell_index()) = std::abs(product);
-      }
-    return result;
+    return recovered_error_products(dof_handler,
+                                    u,
+                                    recovered_u,
+                                    std::vector<Influence<dim>>{
+                                      {&z, &recovered_z}},
+                                    materials,
+                                    with_indicators)[0];
   }
 
 
@@ -225,6 +340,13 @@ namespace knee_contact
 
 #define KNEE_CONTACT_INSTANTIATE(dim)                             \
   template class RecoveredStrain<dim>;                            \
+  template std::vector<RecoveredProduct> recovered_error_products( \
+    const DoFHandler<dim> &,                                      \
+    const Vector<double> &,                                       \
+    const RecoveredStrain<dim> &,                                 \
+    const std::vector<Influence<dim>> &,                          \
+    const Materials<dim> &,                                       \
+    const bool);                                                  \
   template RecoveredProduct recovered_error_product(              \
     const DoFHandler<dim> &,                                      \
     const Vector<double> &,                                       \

@@ -7,6 +7,7 @@
 #include <knee_contact/physics/materials.h>
 #include <knee_contact/postprocess/load_cases.h>
 #include <knee_contact/postprocess/output.h>
+#include <knee_contact/postprocess/recovery.h>
 #include <knee_contact/postprocess/refinement.h>
 #include <knee_contact/postprocess/results.h>
 #include <knee_contact/postprocess/study.h>
@@ -26,6 +27,7 @@
 #include <deal.II/fe/fe_system.h>
 #include <deal.II/grid/tria.h>
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <ostream>
@@ -287,37 +289,64 @@ namespace knee_contact
      */
     std::map<std::string, ErrorEstimate> error_estimates;
     /**
-     * Per reported peak pressure ("peak pressure", "interface NAME: peak
-     * pressure"): the cells' shares of its goal-oriented estimate
-     * (estimate_pressure_errors()), a refinement indicator that serves it.
+     * Per reported peak pressure and contact force ("peak pressure",
+     * "interface NAME: peak pressure", "interface NAME: force"): the
+     * cells' shares of its goal-oriented estimate
+     * (estimate_mesh_errors()), a refinement indicator that serves it.
      */
     std::map<std::string, Vector<float>> goal_indicators;
 
     /**
-     * The goal-oriented error bars of each interface's peak pressure
-     * (frictionless contact): the influence of the peak pair's
-     * multiplier (multiplier_influence()) weights the recovered strain
-     * errors (recovered_error_product()); bar 1.5 |estimate|. Where
-     * error_estimates already holds a bar from a uniformly refined
-     * sequence (@p uniform), the larger of the two is kept: the
-     * recovery does not see the error of curved boundaries approximated by
-     * straight edges, the sequence does. Where the value changed since
-     * the previous mesh by more than both meshes' bars allow (@p previous:
-     * that mesh's estimates), the bars are not consistent with the
-     * refinement (a pressure that does not converge there): the bar is at
-     * least that change, flagged. Fills goal_indicators. Returns the
-     * energy's eta^2 of the same strain recovery (recovered_energy_error()
-     * with the contact tractions imposed; without contact rows or with
-     * friction the plain recovery).
+     * The error bars of this mesh alone. Goal-oriented (frictionless
+     * contact): each interface's peak pressure and contact force, whose
+     * influence (multiplier_influence() of the peak pair and its
+     * neighbours, of all active pairs) weights the recovered strain errors
+     * (recovered_error_product()), bar 1.5 |estimate|; each contact length
+     * (estimate_length_errors()) and each material's stress extremes
+     * (estimate_stress_errors()). A bar of this mesh replaces the mesh
+     * sequence's; where error_estimates already holds a bar from a
+     * uniformly refined sequence (@p uniform), the larger of the two is
+     * kept: the recovery does not see the error of curved boundaries
+     * approximated by straight edges, the sequence does. Where the value
+     * changed since the previous mesh by more than both meshes' bars allow
+     * (@p previous: that mesh's estimates), the bars are not consistent
+     * with the refinement (a quantity that does not converge there): the
+     * bar is at least that change, flagged. Fills goal_indicators (the
+     * peak pressures' and forces'). Returns the energy's eta^2 of the same
+     * strain recovery (recovered_energy_error() with the contact tractions
+     * imposed; without contact rows or with friction the plain recovery).
      */
     double
-    estimate_pressure_errors(
+    estimate_mesh_errors(
       const Results<dim>                         &results,
       const bool                                  uniform,
       const std::map<std::string, ErrorEstimate> &previous);
 
     /**
-     * In target mode for a peak pressure: that pressure's goal indicator
+     * Each interface's contact length bar: one slave spacing at each edge
+     * of the contact zone (the weights of an active slave vertex and an
+     * inactive neighbour on a slave face), handed to @p keep.
+     */
+    void
+    estimate_length_errors(
+      const Results<dim> &results,
+      const std::function<void(const std::string &, ErrorEstimate)> &keep)
+      const;
+
+    /**
+     * Each material's tau_yy min and max and von Mises max bars from the
+     * strain recovery @p recovered of the solution, handed to @p keep.
+     */
+    void
+    estimate_stress_errors(
+      const Results<dim>         &results,
+      const RecoveredStrain<dim> &recovered,
+      const std::function<void(const std::string &, ErrorEstimate)> &keep)
+      const;
+
+    /**
+     * In target mode for a peak pressure or a contact force: its goal
+     * indicator
      * (the adaptive refinement serves it); else none (Kelly's).
      */
     const Vector<float> *

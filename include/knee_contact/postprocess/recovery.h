@@ -81,16 +81,56 @@ namespace knee_contact
                     const Materials<dim>                    &materials,
                     const std::vector<SurfaceTraction<dim>> &tractions = {});
 
+    /**
+     * The recoveries of several displacements in one pass over the cells:
+     * entry i of @p solutions with the tractions @p tractions[i].
+     */
+    static std::vector<RecoveredStrain<dim>>
+    of(const DoFHandler<dim>                                &dof_handler,
+       const std::vector<const Vector<double> *>            &solutions,
+       const Materials<dim>                                 &materials,
+       const std::vector<std::vector<SurfaceTraction<dim>>> &tractions);
+
     /** The recovered strain at @p vertex in @p material. */
     const SymmetricTensor<2, dim> &
     operator()(const unsigned int       vertex,
                const types::material_id material) const;
 
   private:
+    RecoveredStrain() = default;
+
+    /** Imposes @p tractions on the averages (see the class). */
+    void
+    impose(const std::vector<SurfaceTraction<dim>> &tractions,
+           const std::vector<unsigned int>         &vertex_of_dof,
+           const Materials<dim>                    &materials);
+
     std::vector<
       std::vector<std::pair<types::material_id, SymmetricTensor<2, dim>>>>
       averages;
   };
+
+  /** An influence (dual) solution z and its recovery. */
+  template <int dim>
+  struct Influence
+  {
+    const Vector<double>       *z         = nullptr;
+    const RecoveredStrain<dim> *recovered = nullptr;
+  };
+
+  /**
+   * The products above of u with each of @p influences in one pass over
+   * the cells (u's recovered strain error computed once per point); each
+   * entry has the same eta_u_squared.
+   */
+  template <int dim>
+  std::vector<RecoveredProduct>
+  recovered_error_products(const DoFHandler<dim>                &dof_handler,
+                           const Vector<double>                 &u,
+                           const RecoveredStrain<dim>           &recovered_u,
+                           const std::vector<Influence<dim>>    &influences,
+                           const Materials<dim>                 &materials,
+                           const bool with_indicators = false);
 
   /**
    * The products above of u and z from their recoveries @p recovered_u
