@@ -86,6 +86,8 @@ namespace knee_contact
       std::vector<unsigned int> patch;
       double                    scale;
       std::string               basis;
+      // A floor of the bar (the peak's difference from J: see below).
+      double at_least = 0;
     };
     std::vector<Goal> goals;
     std::string       overall;
@@ -135,12 +137,23 @@ namespace knee_contact
               patch.push_back(q);
               length += contact_pairs.rows[q].length;
             }
+        // J is the patch's mean pressure; the reported peak differs from
+        // it by what the mesh resolves of the peak's shape, an error the
+        // estimate of J does not see: where the peak stands out of its
+        // patch (a sharp peak on a coarse mesh) the bar is at least that
+        // difference (measured on the knee's insert-tray, whose peak is
+        // sharp on the example's mesh: 0.18 to 0.71 of the true error
+        // without it).
+        double patch_force = 0;
+        for (const unsigned int q : patch)
+          patch_force += contact_solution.lambda[q];
         goals.push_back({prefix + "peak pressure",
                          peak,
                          patch,
                          1. / length,
                          "goal-oriented: the peak pair's influence and strain "
-                         "recovery"});
+                         "recovery",
+                         peak - patch_force / length});
         // The contact force: J = the sum of the interface's multipliers,
         // whose influence is that of all its active pairs.
         goals.push_back({prefix + "force",
@@ -246,7 +259,8 @@ namespace knee_contact
         // adaptive knees and Hertz after two cycles (Roache's 1.25 left the
         // knee's and the gait case's third mesh outside, at 0.87 and 0.89).
         bar.extrapolated = goals[g].value + estimates[g].product;
-        bar.error        = 1.5 * std::abs(estimates[g].product);
+        bar.error =
+          std::max(1.5 * std::abs(estimates[g].product), goals[g].at_least);
         bar.asymptotic   = true;
         bar.basis        = goals[g].basis;
         keep(goals[g].name, bar);

@@ -189,7 +189,7 @@ namespace knee_contact
             // Reached only with a bar a second mesh has checked (a bar
             // from one mesh does not see the error of curved edges on a
             // coarse mesh: the two rings' first mesh, 180 dofs, has a
-            // goal-oriented bar of 3 % beside a true error of 116 %) and
+            // goal-oriented bar of 13 % beside a true error of 116 %) and
             // that is not flagged.
             if (records.size() >= 2 && target.asymptotic &&
                 std::isfinite(relative) && relative <= refinement.target_error)
