@@ -261,8 +261,8 @@ namespace knee_contact
         bar.extrapolated = goals[g].value + estimates[g].product;
         bar.error =
           std::max(1.5 * std::abs(estimates[g].product), goals[g].at_least);
-        bar.asymptotic   = true;
-        bar.basis        = goals[g].basis;
+        bar.asymptotic = true;
+        bar.basis      = goals[g].basis;
         keep(goals[g].name, bar);
         goal_indicators[goals[g].name] = std::move(estimates[g].indicators);
       }
@@ -279,7 +279,7 @@ namespace knee_contact
   template <int dim>
   void
   ContactProblem<dim>::estimate_length_errors(
-    const Results<dim>                                         &results,
+    const Results<dim>                                            &results,
     const std::function<void(const std::string &, ErrorEstimate)> &keep) const
   {
     // The contact zone's edge lies between an active slave vertex and an
@@ -308,14 +308,13 @@ namespace knee_contact
               }
             for (const unsigned int a : face_pairs)
               for (const unsigned int b : face_pairs)
-                if (contact_solution.active[a] &&
-                    !contact_solution.active[b] &&
+                if (contact_solution.active[a] && !contact_solution.active[b] &&
                     contact_pairs.rows[a].interface ==
                       contact_pairs.rows[b].interface &&
                     edges.emplace(a, b).second)
                   bars[contact_pairs.rows[a].interface] +=
-                    0.5 *
-                    (contact_pairs.rows[a].length + contact_pairs.rows[b].length);
+                    0.5 * (contact_pairs.rows[a].length +
+                           contact_pairs.rows[b].length);
           }
     for (unsigned int i = 0; i < results.interfaces.size(); ++i)
       if (results.interfaces[i].n_active > 0)
@@ -335,8 +334,8 @@ namespace knee_contact
   template <int dim>
   void
   ContactProblem<dim>::estimate_stress_errors(
-    const Results<dim>                                         &results,
-    const RecoveredStrain<dim>                                 &recovered,
+    const Results<dim>                                            &results,
+    const RecoveredStrain<dim>                                    &recovered,
     const std::function<void(const std::string &, ErrorEstimate)> &keep) const
   {
     // Each extreme is taken over the cells' own vertex values (as the
@@ -362,7 +361,7 @@ namespace knee_contact
     };
     // By material: tau_yy min (as -tau_yy max), tau_yy max, von Mises max.
     std::map<types::material_id, std::array<Extreme, 3>> extremes;
-    const unsigned int                                    n_vertices =
+    const unsigned int                                   n_vertices =
       dof_handler.get_fe().reference_cell().n_vertices();
     for (const auto &cell : dof_handler.active_cell_iterators())
       {
@@ -387,9 +386,9 @@ namespace knee_contact
                     e[k].recovered_there = star[k];
                     e[k].cell            = cell;
                   }
-                e[k].recovered = e[k].set ? std::max(e[k].recovered, star[k])
-                                          : star[k];
-                e[k].set       = true;
+                e[k].recovered =
+                  e[k].set ? std::max(e[k].recovered, star[k]) : star[k];
+                e[k].set = true;
               }
           }
       }

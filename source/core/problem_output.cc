@@ -182,8 +182,7 @@ namespace knee_contact
         error_estimates.clear();
         {
           TimerOutput::Scope scope(timer, "error estimate");
-          const double       eta_squared =
-            estimate_mesh_errors(results, false, {});
+          const double eta_squared = estimate_mesh_errors(results, false, {});
           error_estimates["energy"] =
             recovered_energy_estimate(results.energy, eta_squared);
         }

@@ -145,8 +145,8 @@ namespace knee_contact
             Timer              clock;
             record.recovered_energy_error =
               estimate_mesh_errors(results,
-                                       strategy == Refinement::Strategy::global,
-                                       previous);
+                                   strategy == Refinement::Strategy::global,
+                                   previous);
             error_estimates["energy"] =
               recovered_energy_estimate(record.energy,
                                         record.recovered_energy_error);

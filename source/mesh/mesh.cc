@@ -197,26 +197,18 @@ namespace knee_contact
           Rectangle r;
           r.lower = Point<2>(std::get<0>(entry), std::get<1>(entry));
           r.upper = Point<2>(std::get<2>(entry), std::get<3>(entry));
+          const std::string rectangle = "Mesh/Rectangles: a rectangle from (" +
+                                        std::to_string(r.lower[0]) + ", " +
+                                        std::to_string(r.lower[1]) + ") to (" +
+                                        std::to_string(r.upper[0]) + ", " +
+                                        std::to_string(r.upper[1]) + ")";
           AssertThrow(r.upper[0] > r.lower[0] && r.upper[1] > r.lower[1],
-                      ExcMessage("Mesh/Rectangles: a rectangle from (" +
-                                 std::to_string(r.lower[0]) + ", " +
-                                 std::to_string(r.lower[1]) + ") to (" +
-                                 std::to_string(r.upper[0]) + ", " +
-                                 std::to_string(r.upper[1]) +
-                                 ") needs x1 > x0 and y1 > y0"));
+                      ExcMessage(rectangle + " needs x1 > x0 and y1 > y0"));
+          AssertThrow(std::isfinite(r.upper[0] - r.lower[0]) &&
+                        std::isfinite(r.upper[1] - r.lower[1]),
+                      ExcMessage(rectangle + " is not finite"));
           r.n_x          = std::get<4>(entry);
           r.n_y          = std::get<5>(entry);
-          AssertThrow(std::isfinite(r.lower[0]) && std::isfinite(r.lower[1]) &&
-                        std::isfinite(r.upper[0]) &&
-                        std::isfinite(r.upper[1]) &&
-                        std::isfinite(r.upper[0] - r.lower[0]) &&
-                        std::isfinite(r.upper[1] - r.lower[1]),
-                      ExcMessage("Mesh/Rectangles: a rectangle from (" +
-                                 std::to_string(r.lower[0]) + ", " +
-                                 std::to_string(r.lower[1]) + ") to (" +
-                                 std::to_string(r.upper[0]) + ", " +
-                                 std::to_string(r.upper[1]) +
-                                 ") is not finite"));
           r.material_id  = static_cast<types::material_id>(std::get<6>(entry));
           r.group        = std::get<7>(entry);
           r.boundary_ids = {{std::get<8>(entry),
@@ -236,9 +228,8 @@ namespace knee_contact
                                   (r.upper[0] - r.lower[0]) / r.n_x,
                                   (r.upper[1] - r.lower[1]) / r.n_y});
         for (unsigned int d = 0; d < 2; ++d)
-          extent = std::max({extent,
-                             std::abs(r.lower[d]),
-                             std::abs(r.upper[d])});
+          extent =
+            std::max({extent, std::abs(r.lower[d]), std::abs(r.upper[d])});
       }
     if (!(extent < 1e12 * smallest_cell))
       {

@@ -411,7 +411,7 @@ namespace knee_contact
                                std::to_string(centre[1]) +
                                ") lies inside none of the rectangles"));
         const Rectangle &rect = *found;
-        const double tol = 1e-8 * cell->diameter();
+        const double     tol  = 1e-8 * cell->diameter();
         for (const unsigned int f : cell->face_indices())
           if (cell->face(f)->at_boundary())
             {

@@ -78,9 +78,8 @@ namespace knee_contact
     bool                                   any_traction = false;
     for (const auto &t : tractions)
       any_traction = any_traction || !t.empty();
-    std::vector<unsigned int>            vertex_of_dof(any_traction ?
-                                                         dof_handler.n_dofs() :
-                                                         0,
+    std::vector<unsigned int> vertex_of_dof(any_traction ? dof_handler.n_dofs()
+                                                         : 0,
                                             numbers::invalid_unsigned_int);
     FEValues<dim>                        nodal(elements::mapping(dof_handler),
                         fe,
@@ -282,9 +281,10 @@ namespace knee_contact
               {
                 SymmetricTensor<2, dim> error_z = -strains_z[i][q];
                 for (unsigned int v = 0; v < n_vertices; ++v)
-                  error_z += fe_values.shape_value(
-                               fe.component_to_system_index(0, v), q) *
-                             vertex_z[i][v];
+                  error_z +=
+                    fe_values.shape_value(fe.component_to_system_index(0, v),
+                                          q) *
+                    vertex_z[i][v];
                 products[i] += error_z * stress_u * fe_values.JxW(q);
               }
           }
@@ -338,25 +338,25 @@ namespace knee_contact
 
 
 
-#define KNEE_CONTACT_INSTANTIATE(dim)                             \
-  template class RecoveredStrain<dim>;                            \
+#define KNEE_CONTACT_INSTANTIATE(dim)                              \
+  template class RecoveredStrain<dim>;                             \
   template std::vector<RecoveredProduct> recovered_error_products( \
-    const DoFHandler<dim> &,                                      \
-    const Vector<double> &,                                       \
-    const RecoveredStrain<dim> &,                                 \
-    const std::vector<Influence<dim>> &,                          \
-    const Materials<dim> &,                                       \
-    const bool);                                                  \
-  template RecoveredProduct recovered_error_product(              \
-    const DoFHandler<dim> &,                                      \
-    const Vector<double> &,                                       \
-    const RecoveredStrain<dim> &,                                 \
-    const Vector<double> &,                                       \
-    const RecoveredStrain<dim> &,                                 \
-    const Materials<dim> &,                                       \
-    const bool);                                                  \
-  template double recovered_energy_error(const DoFHandler<dim> &, \
-                                         const Vector<double> &,  \
+    const DoFHandler<dim> &,                                       \
+    const Vector<double> &,                                        \
+    const RecoveredStrain<dim> &,                                  \
+    const std::vector<Influence<dim>> &,                           \
+    const Materials<dim> &,                                        \
+    const bool);                                                   \
+  template RecoveredProduct recovered_error_product(               \
+    const DoFHandler<dim> &,                                       \
+    const Vector<double> &,                                        \
+    const RecoveredStrain<dim> &,                                  \
+    const Vector<double> &,                                        \
+    const RecoveredStrain<dim> &,                                  \
+    const Materials<dim> &,                                        \
+    const bool);                                                   \
+  template double recovered_energy_error(const DoFHandler<dim> &,  \
+                                         const Vector<double> &,   \
                                          const Materials<dim> &);
   KNEE_CONTACT_INSTANTIATE(2)
   KNEE_CONTACT_INSTANTIATE(3)

@@ -97,12 +97,8 @@ SCENES = [
 ]
 
 
-def run(binary, scene, folder, refinement=None, name=None, entries=None):
-    """The scene with an absolute mesh path, its output in folder (as
-    name), with the Refinement entries of @p refinement (a dict) and the
-    @p entries ({"Subsection/Sub": {name: value}}) in place of its own;
-    the rows of its study.csv, the run's summary.json and the rows of its
-    load_cases.csv (empty without load cases)."""
+def with_absolute_mesh(scene):
+    """The scene's text with its Mesh/File as an absolute path."""
     with open(scene) as f:
         text = f.read()
     base = os.path.dirname(scene)
@@ -113,8 +109,17 @@ def run(binary, scene, folder, refinement=None, name=None, entries=None):
             value = os.path.normpath(os.path.join(base, value))
         return match.group(1) + value
 
-    text = re.sub(r"^(\s*set\s+File\s*=\s*)(.*)$", absolute, text,
+    return re.sub(r"^(\s*set\s+File\s*=\s*)(.*)$", absolute, text,
                   flags=re.MULTILINE)
+
+
+def run(binary, scene, folder, refinement=None, name=None, entries=None):
+    """The scene with an absolute mesh path, its output in folder (as
+    name), with the Refinement entries of @p refinement (a dict) and the
+    @p entries ({"Subsection/Sub": {name: value}}) in place of its own;
+    the rows of its study.csv, the run's summary.json and the rows of its
+    load_cases.csv (empty without load cases)."""
+    text = with_absolute_mesh(scene)
     # The run's own output settings (a scene may set an entry once).
     text = re.sub(r"^\s*set\s+(Write files|Folder|Pictures|Terminal)\s*=.*$",
                   "", text, flags=re.MULTILINE)

@@ -38,7 +38,7 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from error_bars import ACCURACY, run  # noqa: E402
+from error_bars import ACCURACY, run, with_absolute_mesh  # noqa: E402
 
 # Reference (value, uncertainty) per quantity, from the uniform sequences
 # described above.
@@ -85,19 +85,8 @@ SCENES = [
 def refined_copy(scene, level, folder):
     """The scene with an absolute mesh path and Mesh/Global refinements =
     level, written into folder."""
-    with open(scene) as f:
-        text = f.read()
-    base = os.path.dirname(scene)
-
-    def absolute(match):
-        value = match.group(2).strip()
-        if value and not os.path.isabs(value):
-            value = os.path.normpath(os.path.join(base, value))
-        return match.group(1) + value
-
-    text = re.sub(r"^(\s*set\s+File\s*=\s*)(.*)$", absolute, text,
-                  flags=re.MULTILINE)
-    text = re.sub(r"^\s*set\s+Global refinements\s*=.*$", "", text,
+    text = re.sub(r"^\s*set\s+Global refinements\s*=.*$", "",
+                  with_absolute_mesh(scene),
                   flags=re.MULTILINE)
     text, n = re.subn(r"^subsection Mesh\n",
                       "subsection Mesh\n  set Global refinements = %d\n"

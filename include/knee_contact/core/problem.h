@@ -317,10 +317,9 @@ namespace knee_contact
      * imposed; without contact rows or with friction the plain recovery).
      */
     double
-    estimate_mesh_errors(
-      const Results<dim>                         &results,
-      const bool                                  uniform,
-      const std::map<std::string, ErrorEstimate> &previous);
+    estimate_mesh_errors(const Results<dim>                         &results,
+                         const bool                                  uniform,
+                         const std::map<std::string, ErrorEstimate> &previous);
 
     /**
      * Each interface's contact length bar: one slave spacing at each edge
@@ -329,7 +328,7 @@ namespace knee_contact
      */
     void
     estimate_length_errors(
-      const Results<dim> &results,
+      const Results<dim>                                            &results,
       const std::function<void(const std::string &, ErrorEstimate)> &keep)
       const;
 
@@ -339,8 +338,8 @@ namespace knee_contact
      */
     void
     estimate_stress_errors(
-      const Results<dim>         &results,
-      const RecoveredStrain<dim> &recovered,
+      const Results<dim>                                            &results,
+      const RecoveredStrain<dim>                                    &recovered,
       const std::function<void(const std::string &, ErrorEstimate)> &keep)
       const;
 

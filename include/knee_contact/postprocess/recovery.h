@@ -125,11 +125,11 @@ namespace knee_contact
    */
   template <int dim>
   std::vector<RecoveredProduct>
-  recovered_error_products(const DoFHandler<dim>                &dof_handler,
-                           const Vector<double>                 &u,
-                           const RecoveredStrain<dim>           &recovered_u,
-                           const std::vector<Influence<dim>>    &influences,
-                           const Materials<dim>                 &materials,
+  recovered_error_products(const DoFHandler<dim>             &dof_handler,
+                           const Vector<double>              &u,
+                           const RecoveredStrain<dim>        &recovered_u,
+                           const std::vector<Influence<dim>> &influences,
+                           const Materials<dim>              &materials,
                            const bool with_indicators = false);
 
   /**
