@@ -301,7 +301,8 @@ namespace knee_contact
      * contact): each interface's peak pressure and contact force, whose
      * influence (multiplier_influence() of the peak pair and its
      * neighbours, of all active pairs) weights the recovered strain errors
-     * (recovered_error_product()), bar 1.5 |estimate|; each contact length
+     * (recovered_error_products()), bar 1.5 |estimate| (a peak pressure's
+     * at least its difference from its patch's mean); each contact length
      * (estimate_length_errors()) and each material's stress extremes
      * (estimate_stress_errors()). A bar of this mesh replaces the mesh
      * sequence's; where error_estimates already holds a bar from a
@@ -345,8 +346,7 @@ namespace knee_contact
 
     /**
      * In target mode for a peak pressure or a contact force: its goal
-     * indicator
-     * (the adaptive refinement serves it); else none (Kelly's).
+     * indicator (the adaptive refinement serves it); else none (Kelly's).
      */
     const Vector<float> *
     goal_indicator() const
