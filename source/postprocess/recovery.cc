@@ -303,41 +303,6 @@ namespace knee_contact
 
 
 
-  template <int dim>
-  RecoveredProduct
-  recovered_error_product(const DoFHandler<dim>      &dof_handler,
-                          const Vector<double>       &u,
-                          const RecoveredStrain<dim> &recovered_u,
-                          const Vector<double>       &z,
-                          const RecoveredStrain<dim> &recovered_z,
-                          const Materials<dim>       &materials,
-                          const bool                  with_indicators)
-  {
-    return recovered_error_products(dof_handler,
-                                    u,
-                                    recovered_u,
-                                    std::vector<Influence<dim>>{
-                                      {&z, &recovered_z}},
-                                    materials,
-                                    with_indicators)[0];
-  }
-
-
-
-  template <int dim>
-  double
-  recovered_energy_error(const DoFHandler<dim> &dof_handler,
-                         const Vector<double>  &solution,
-                         const Materials<dim>  &materials)
-  {
-    const RecoveredStrain<dim> recovered(dof_handler, solution, materials);
-    return recovered_error_product(
-             dof_handler, solution, recovered, solution, recovered, materials)
-      .eta_u_squared;
-  }
-
-
-
 #define KNEE_CONTACT_INSTANTIATE(dim)                              \
   template class RecoveredStrain<dim>;                             \
   template std::vector<RecoveredProduct> recovered_error_products( \
@@ -346,18 +311,7 @@ namespace knee_contact
     const RecoveredStrain<dim> &,                                  \
     const std::vector<Influence<dim>> &,                           \
     const Materials<dim> &,                                        \
-    const bool);                                                   \
-  template RecoveredProduct recovered_error_product(               \
-    const DoFHandler<dim> &,                                       \
-    const Vector<double> &,                                        \
-    const RecoveredStrain<dim> &,                                  \
-    const Vector<double> &,                                        \
-    const RecoveredStrain<dim> &,                                  \
-    const Materials<dim> &,                                        \
-    const bool);                                                   \
-  template double recovered_energy_error(const DoFHandler<dim> &,  \
-                                         const Vector<double> &,   \
-                                         const Materials<dim> &);
+    const bool);
   KNEE_CONTACT_INSTANTIATE(2)
   KNEE_CONTACT_INSTANTIATE(3)
 #undef KNEE_CONTACT_INSTANTIATE

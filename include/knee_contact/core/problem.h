@@ -314,7 +314,7 @@ namespace knee_contact
      * with the refinement (a quantity that does not converge there): the
      * bar is at least that change, flagged. Fills goal_indicators (the
      * peak pressures' and forces'). Returns the energy's eta^2 of the same
-     * strain recovery (recovered_energy_error() with the contact tractions
+     * strain recovery (recovered_error_products() with the contact tractions
      * imposed; without contact rows or with friction the plain recovery).
      */
     double

@@ -76,7 +76,7 @@ namespace knee_contact
 
   /**
    * The energy's bar from one mesh: 1.25 @p eta_squared (the strain
-   * recovery's estimate of a(u - u_h, u - u_h), recovered_energy_error(),
+   * recovery's estimate of a(u - u_h, u - u_h), recovered_error_products(),
    * with Roache's safety factor), at least the energy's round-off, 1e-13
    * of @p energy (an exactly represented solution: a patch test).
    */

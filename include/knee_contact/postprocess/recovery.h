@@ -132,32 +132,6 @@ namespace knee_contact
                            const Materials<dim>              &materials,
                            const bool with_indicators = false);
 
-  /**
-   * The products above of u and z from their recoveries @p recovered_u
-   * and @p recovered_z.
-   */
-  template <int dim>
-  RecoveredProduct
-  recovered_error_product(const DoFHandler<dim>      &dof_handler,
-                          const Vector<double>       &u,
-                          const RecoveredStrain<dim> &recovered_u,
-                          const Vector<double>       &z,
-                          const RecoveredStrain<dim> &recovered_z,
-                          const Materials<dim>       &materials,
-                          const bool                  with_indicators = false);
-
-  /**
-   * The Zienkiewicz-Zhu estimate eta^2 of a(u - u_h, u - u_h): the
-   * recovery above of @p solution alone (no contact tractions). eta^2
-   * estimates the error of the energy a(u, u) that the run reports
-   * (Galerkin orthogonality: a(u, u) - a(u_h, u_h) = a(u - u_h, u - u_h)
-   * for the linear problem; with contact up to the contact terms).
-   */
-  template <int dim>
-  double
-  recovered_energy_error(const DoFHandler<dim> &dof_handler,
-                         const Vector<double>  &solution,
-                         const Materials<dim>  &materials);
 } // namespace knee_contact
 
 #endif

@@ -39,7 +39,8 @@ namespace knee_contact
     double estimated_peak_pressure_error =
       std::numeric_limits<double>::quiet_NaN();
     double estimated_energy_error = std::numeric_limits<double>::quiet_NaN();
-    /** eta^2 of recovered_energy_error() on this mesh [J/m, J]. */
+    /** eta^2 of the strain recovery (recovered_error_products()) on this mesh
+     * [J/m, J]. */
     double recovered_energy_error = std::numeric_limits<double>::quiet_NaN();
     /** The contact solver's path and figures (summary.json's "solver"). */
     std::string                   solver;
