@@ -19,12 +19,11 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 
-def main():
-    folder = sys.argv[1]
+def draw(folder):
     with open(os.path.join(folder, "load_cases.csv")) as f:
         rows = list(csv.DictReader(f))
     if not rows:
-        raise SystemExit("load_cases.csv has no cases")
+        raise ValueError("load_cases.csv has no cases")
     columns = list(rows[0].keys())
     t = [float(r["t"]) for r in rows]
     interfaces = [c[: -len("_peak_pressure")] for c in columns
@@ -77,6 +76,12 @@ def main():
     figure.savefig(temporary, dpi=150, bbox_inches="tight")
     plt.close(figure)
     os.replace(temporary, path)
+
+
+def main():
+    if len(sys.argv) != 2:
+        sys.exit("usage: plot_load_cases.py FOLDER")
+    draw(sys.argv[1])
 
 
 if __name__ == "__main__":

@@ -175,10 +175,7 @@ def contact_friction(folder):
     save(figure, os.path.join(folder, "contact_friction.png"))
 
 
-def main():
-    if len(sys.argv) != 2:
-        sys.exit("usage: plot_results.py FOLDER")
-    folder = sys.argv[1]
+def draw(folder):
     with open(os.path.join(folder, "summary.json")) as f:
         summary = json.load(f)
     material, vertex = read_cells(folder)
@@ -186,6 +183,12 @@ def main():
     stress_yy(folder, material, vertex)
     contact_pressure(folder, summary)
     contact_friction(folder)
+
+
+def main():
+    if len(sys.argv) != 2:
+        sys.exit("usage: plot_results.py FOLDER")
+    draw(sys.argv[1])
 
 
 if __name__ == "__main__":

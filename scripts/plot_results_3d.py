@@ -27,7 +27,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from plot_results import save  # noqa: E402
 
 
-def main(folder):
+def draw(folder):
     with open(os.path.join(folder, "summary.json")) as f:
         summary = json.load(f)
     data = np.load(os.path.join(folder, "surface.npy")).astype(float)
@@ -66,4 +66,6 @@ def main(folder):
 
 
 if __name__ == "__main__":
-    main(sys.argv[1])
+    if len(sys.argv) != 2:
+        sys.exit("usage: plot_results_3d.py FOLDER")
+    draw(sys.argv[1])

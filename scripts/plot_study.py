@@ -31,8 +31,7 @@ def save(figure, path):
     os.replace(temporary, path)
 
 
-def main():
-    folder = sys.argv[1]
+def draw(folder):
     with open(os.path.join(folder, "study.csv")) as f:
         rows = list(csv.DictReader(f))
     strategies = []
@@ -73,6 +72,12 @@ def main():
                 if hit else "not reached, -"))
     with open(os.path.join(folder, "study_cost.txt"), "w") as f:
         f.write("\n".join(lines) + "\n")
+
+
+def main():
+    if len(sys.argv) != 2:
+        sys.exit("usage: plot_study.py FOLDER")
+    draw(sys.argv[1])
 
 
 if __name__ == "__main__":

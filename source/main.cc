@@ -1,6 +1,7 @@
 #include <knee_contact/core/input.h>
 #include <knee_contact/core/interruption.h>
 #include <knee_contact/core/problem.h>
+#include <knee_contact/core/progress.h>
 
 #include <deal.II/base/multithread_info.h>
 
@@ -26,6 +27,7 @@ main(int argc, char **argv)
     "documentation and default\n"
     "       knee_contact --help\n";
   interruption::install();
+  Progress::start_clock();
   try
     {
       if (argc == 2 && (std::strcmp(argv[1], "--help") == 0 ||

@@ -22,7 +22,10 @@ namespace knee_contact
       constexpr std::size_t  max_length = 4096;
       char                   folders[max_paths][max_length];
       char                   files[max_paths][max_length];
-      std::atomic<pid_t>     child{0};
+      // The process groups of running external programs (gmsh, the
+      // picture process): at most two at once, a slot is free at 0.
+      constexpr unsigned int max_children = 4;
+      std::atomic<pid_t>     children[max_children];
 
       void
       put(char (&slots)[max_paths][max_length], const std::string &path)
@@ -86,12 +89,15 @@ namespace knee_contact
       void
       handle(const int signal)
       {
-        const pid_t group = child.load();
-        if (group > 0)
+        for (auto &child : children)
           {
-            kill(-group, SIGKILL);
-            while (waitpid(group, nullptr, 0) < 0 && errno == EINTR)
-              ;
+            const pid_t group = child.load();
+            if (group > 0)
+              {
+                kill(-group, SIGKILL);
+                while (waitpid(group, nullptr, 0) < 0 && errno == EINTR)
+                  ;
+              }
           }
         for (const auto &folder : folders)
           if (folder[0] != '\0')
@@ -155,9 +161,26 @@ namespace knee_contact
 
 
     void
-    set_child(const pid_t process_group)
+    add_child(const pid_t process_group)
     {
-      child.store(process_group);
+      for (auto &child : children)
+        {
+          pid_t free = 0;
+          if (child.compare_exchange_strong(free, process_group))
+            return;
+        }
+    }
+
+
+
+    void
+    remove_child(const pid_t process_group)
+    {
+      for (auto &child : children)
+        {
+          pid_t group = process_group;
+          child.compare_exchange_strong(group, 0);
+        }
     }
   } // namespace interruption
 } // namespace knee_contact

@@ -1,6 +1,7 @@
 // The files of a run: result sets, load cases and the results table
 // (ContactProblem's output, split from problem.cc by job).
 #include <knee_contact/core/problem.h>
+#include <knee_contact/core/progress.h>
 #include <knee_contact/physics/elasticity.h>
 
 #include <deal.II/base/data_out_base.h>
@@ -157,11 +158,13 @@ namespace knee_contact
     // mesh (the energy's strain recovery, the peak pressures' goal-oriented
     // estimate), no sequence bars.
     unsigned int n_failed = 0;
+    Progress     progress(log(), "load case", t.size() - 1, false, 1);
     for (unsigned int c = 1; c < t.size() && contact_solution.converged; ++c)
       {
         std::cout << "load case " << c << ": t = " << t[c] << std::endl;
         set_load_parameter(t[c]);
         Timer clock;
+        Timer case_clock;
         {
           TimerOutput::Scope scope(timer, "load cases: assembly");
           ElasticityAssembler<dim>(materials, boundary_conditions)
@@ -201,6 +204,8 @@ namespace knee_contact
             output_writer.set_subfolder(LoadCases::folder(c));
             write_result_set(results, {}, timer);
           }
+        // Case c is the (c - 1)-th after the first, which the cycles solved.
+        progress.step_done(c - 1, case_clock.wall_time());
       }
 
     LoadCases::print_table(records, !output_writer.test_mode(), std::cout);

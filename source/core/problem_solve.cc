@@ -2,6 +2,7 @@
 // refinement cycle (ContactProblem's orchestration, split from problem.cc
 // by job as ASPECT splits its Simulator).
 #include <knee_contact/core/problem.h>
+#include <knee_contact/core/progress.h>
 #include <knee_contact/mesh/scene_checks.h>
 #include <knee_contact/physics/elasticity.h>
 #include <knee_contact/physics/rigid_modes.h>
@@ -30,6 +31,8 @@ namespace knee_contact
     const unsigned int       n_cycles = strategy == Refinement::Strategy::global
                                           ? refinement.n_cycles
                                           : refinement.n_adaptive_cycles;
+    Progress                 progress(
+      log(), Refinement::name(strategy) + " cycle", n_cycles, true, 0);
     for (unsigned int cycle = 0; cycle < n_cycles; ++cycle)
       {
         CycleRecord record;
@@ -210,6 +213,7 @@ namespace knee_contact
                 std::to_string(n_cycles) +
                 " cycles; raise the number of cycles or the target");
           }
+        progress.step_done(cycle, record.total_time);
       }
     return records;
   }

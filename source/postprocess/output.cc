@@ -154,6 +154,16 @@ namespace knee_contact
   {
     if (write_files)
       result_folder = std::make_unique<ResultFolder>(output_folder);
+    // Started now, Python's and matplotlib's start overlaps the solve (the
+    // small scenes' pictures took 2-4 s, most of it that start).
+    if (write_files && pictures)
+      {
+        const std::string script = find_script("pictures.py");
+        picture_process          = std::make_unique<HelperProcess>();
+        if (script.empty() ||
+            !picture_process->start({"/usr/bin/python3", script}))
+          picture_process.reset();
+      }
   }
 
 
@@ -162,6 +172,7 @@ namespace knee_contact
   void
   OutputWriter<dim>::commit()
   {
+    picture_process.reset();
     if (result_folder)
       result_folder->commit();
     result_folder.reset();
@@ -245,12 +256,20 @@ namespace knee_contact
         return false;
       }
     // An argument vector, no shell: the folder name is data.
-    const std::string   log    = staging("pictures.log");
-    const ProgramResult result = run_program(
-      {"/usr/bin/python3", script, result_folder->staging() + "/" + subfolder},
-      log,
-      picture_time_limit);
-    std::filesystem::remove(log);
+    const std::string folder = result_folder->staging() + "/" + subfolder;
+    ProgramResult     result;
+    if (picture_process && picture_process->running())
+      result = picture_process->request(
+        {std::filesystem::path(script_name).stem().string(), folder},
+        picture_time_limit);
+    else
+      {
+        const std::string log = staging("pictures.log");
+        result = run_program({"/usr/bin/python3", script, folder},
+                             log,
+                             picture_time_limit);
+        std::filesystem::remove(log);
+      }
     if (result.exit_code == 0)
       return true;
     message = describe_failure(result,

@@ -1,4 +1,5 @@
 #include <knee_contact/core/input.h>
+#include <knee_contact/core/progress.h>
 #include <knee_contact/solver/active_set.h>
 
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
@@ -458,7 +459,7 @@ namespace knee_contact
             << std::setw(5) << n_active << " active pairs (+" << n_entered
             << " -" << n_left << "), complementarity residual "
             << std::scientific << std::setprecision(2) << result.complementarity
-            << std::defaultfloat << std::endl;
+            << std::defaultfloat << Progress::stamp(log) << std::endl;
 
         if (next == result.active && result.complementarity <= tolerance)
           return result;

@@ -1,3 +1,4 @@
+#include <knee_contact/core/progress.h>
 #include <knee_contact/solver/active_set.h>
 
 #include <algorithm>
@@ -233,7 +234,8 @@ namespace knee_contact
             << n_stick << " sticking, " << std::setw(5) << n_contact - n_stick
             << " slipping, residual " << std::scientific << std::setprecision(2)
             << result.complementarity << ", slip force change "
-            << force_change / force_scale << std::defaultfloat << std::endl;
+            << force_change / force_scale << std::defaultfloat
+            << Progress::stamp(log) << std::endl;
 
         // The pairs' figures of this iteration, also when it fails (the
         // results of a failed case are still reported, and a study or a

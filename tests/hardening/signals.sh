@@ -43,7 +43,9 @@ wait_for() { # wait_for SECONDS COMMAND...: poll until COMMAND succeeds
 in_solve() { grep -q "active set iteration" run.log; }
 staged() { compgen -G ".out put's \$x;y.new-*/$1" >/dev/null; }
 writing_output() { staged solution.vtu; }
-drawing() { staged pictures.log; }
+# The picture process writes each figure under a temporary name, then
+# renames it: a staged picture of either name means it is drawing.
+drawing() { staged "*.png"; }
 
 n=0
 for phase in in_solve writing_output drawing; do

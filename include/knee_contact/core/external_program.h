@@ -1,6 +1,8 @@
 #ifndef knee_contact_external_program_h
 #define knee_contact_external_program_h
 
+#include <sys/types.h>
+
 #include <string>
 #include <vector>
 
@@ -33,6 +35,58 @@ namespace knee_contact
   run_program(const std::vector<std::string> &arguments,
               const std::string              &log,
               const double                    time_limit);
+
+  /**
+   * A helper program that lives as long as a run and serves requests: the
+   * picture process (scripts/pictures.py), started before the solve so that
+   * Python's start overlaps it. Started like run_program() (posix_spawn, no
+   * shell, its own process group, killed on an interruption); its standard
+   * input and file descriptor 3 are one end of a socket pair: a request is
+   * a list of fields, each sent followed by a NUL byte (a path cannot hold
+   * one), an answer is one line, "ok" or "error: ...". Its standard output
+   * and error go to a file that has no name (nothing is left behind), read
+   * back for the message of a failure.
+   *
+   * Written by hand: neither deal.II nor the C++ library has a child
+   * process with pipes.
+   */
+  class HelperProcess
+  {
+  public:
+    /**
+     * Start @p arguments; false (and no process) if it cannot be started.
+     */
+    bool
+    start(const std::vector<std::string> &arguments);
+
+    /** Running, and answering so far. */
+    bool
+    running() const
+    {
+      return pid > 0;
+    }
+
+    /**
+     * Send @p fields and wait for the answer at most @p time_limit seconds.
+     * No answer in time kills the process; then, or if it has ended, the
+     * result gives its exit code or signal and the message of its log, and
+     * it is no longer running().
+     */
+    ProgramResult
+    request(const std::vector<std::string> &fields, const double time_limit);
+
+    /** Kill it: no request waits for an answer at its end. */
+    ~HelperProcess();
+
+  private:
+    void
+    stop(ProgramResult *result, const bool kill_now);
+
+    pid_t       pid    = 0;
+    int         socket = -1;
+    int         log    = -1;
+    std::string buffer;
+  };
 
   /**
    * One line for a failed run of @p program on @p file: "gmsh failed on

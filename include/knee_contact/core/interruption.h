@@ -45,11 +45,15 @@ namespace knee_contact
     unregister_file(const std::string &file);
 
     /**
-     * The process group of a running external program, killed (SIGKILL) if
-     * a signal arrives; 0 when none runs.
+     * The process group of a running external program (gmsh, the picture
+     * process), killed (SIGKILL) if a signal arrives; at most four at once.
      */
     void
-    set_child(pid_t process_group);
+    add_child(pid_t process_group);
+
+    /** The program of @p process_group has ended. */
+    void
+    remove_child(pid_t process_group);
   } // namespace interruption
 } // namespace knee_contact
 

@@ -2,6 +2,7 @@
 #define knee_contact_output_h
 
 #include <knee_contact/contact/contact.h>
+#include <knee_contact/core/external_program.h>
 #include <knee_contact/core/result_folder.h>
 #include <knee_contact/physics/materials.h>
 #include <knee_contact/postprocess/error_estimate.h>
@@ -90,9 +91,11 @@ namespace knee_contact
                 const Results<dim>              &results) const;
 
     /**
-     * Run scripts/@p script (Debian's python3 with matplotlib) on the
-     * folder, e.g. plot_results.py: deformation, tau_yy and contact pressure
-     * pictures. Does nothing if pictures are off. Returns false, with the
+     * Draw the pictures of scripts/@p script (Debian's python3 with
+     * matplotlib) in the folder, e.g. plot_results.py: deformation, tau_yy
+     * and contact pressure pictures; by the run's picture process
+     * (scripts/pictures.py, started by prepare()), else by the script on
+     * its own. Does nothing if pictures are off. Returns false, with the
      * script's last line in @p message, if it failed.
      */
     bool
@@ -163,7 +166,9 @@ namespace knee_contact
     /** "" or the current case's folder with a trailing '/'. */
     std::string subfolder;
 
-    std::unique_ptr<ResultFolder>                   result_folder;
+    std::unique_ptr<ResultFolder> result_folder;
+    /** The run's picture process (none if pictures are off). */
+    mutable std::unique_ptr<HelperProcess>          picture_process;
     std::vector<std::string>                        warnings;
     double                                          picture_time_limit = 600;
     std::string                                     output_folder;
