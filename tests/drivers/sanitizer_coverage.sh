@@ -26,8 +26,7 @@ cd "$build"
 report=$build/coverage.txt
 : >"$report"
 find "$build/CMakeFiles" -name '*.gcno' | while read -r note; do
-  object=${note%.gcno}
-  gcov -n -o "$(dirname "$object")" "$object" 2>/dev/null |
+  gcov -n -o "$note" "${note%.gcno}.o" 2>/dev/null |
     awk -v root="$source_dir/source/" '
       /^File / { file = $2; gsub("\047", "", file) }
       /^Lines executed:/ && index(file, root) == 1 {
