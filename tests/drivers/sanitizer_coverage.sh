@@ -4,7 +4,7 @@
 # "sanitizer" there, and prints per source file the lines it executed (gcov's
 # count of lines with code). Fails if a source file under source/ executed
 # none. Not a ctest test: it builds the whole project once more (about 4
-# minutes on 2 cores) and runs the sanitizer set (about 10).
+# minutes on 2 cores) and runs the sanitizer set (3 to 6 minutes).
 # Usage: tests/drivers/sanitizer_coverage.sh [BUILD]   (default build-coverage)
 set -euo pipefail
 source_dir=$(cd "$(dirname "$0")/../.." && pwd)
