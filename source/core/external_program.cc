@@ -92,6 +92,44 @@ namespace knee_contact
 
 
 
+    // Wait for @p pid's end, at most @p time_limit seconds; then kill its
+    // process group (and set @p timed_out). Its children may outlive it in
+    // its group: they are killed too, they must not write on. Returns the
+    // wait status; the process is no longer registered for interruptions.
+    int
+    wait_at_most(const pid_t pid, const double time_limit, bool &timed_out)
+    {
+      const auto start       = std::chrono::steady_clock::now();
+      int        wait_status = 0;
+      for (;;)
+        {
+          const pid_t done = waitpid(pid, &wait_status, WNOHANG);
+          if (done == pid)
+            break;
+          if (done < 0 && errno != EINTR)
+            {
+              wait_status = 0;
+              break;
+            }
+          if (std::chrono::duration<double>(std::chrono::steady_clock::now() -
+                                            start)
+                .count() > time_limit)
+            {
+              kill(-pid, SIGKILL);
+              while (waitpid(pid, &wait_status, 0) < 0 && errno == EINTR)
+                ;
+              timed_out = true;
+              break;
+            }
+          std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        }
+      kill(-pid, SIGKILL);
+      interruption::remove_child(pid);
+      return wait_status;
+    }
+
+
+
     void
     set_status(const int wait_status, ProgramResult &result)
     {
@@ -125,34 +163,7 @@ namespace knee_contact
     if (pid <= 0)
       return result;
 
-    const auto start = std::chrono::steady_clock::now();
-    int        wait_status;
-    for (;;)
-      {
-        const pid_t done = waitpid(pid, &wait_status, WNOHANG);
-        if (done == pid)
-          break;
-        if (done < 0 && errno != EINTR)
-          {
-            wait_status = 0;
-            break;
-          }
-        const double elapsed = std::chrono::duration<double>(
-                                 std::chrono::steady_clock::now() - start)
-                                 .count();
-        if (elapsed > time_limit)
-          {
-            kill(-pid, SIGKILL);
-            while (waitpid(pid, &wait_status, 0) < 0 && errno == EINTR)
-              ;
-            result.timed_out = true;
-            break;
-          }
-        std::this_thread::sleep_for(std::chrono::milliseconds(20));
-      }
-    // Its children may outlive it in its group; they must not write on.
-    kill(-pid, SIGKILL);
-    interruption::remove_child(pid);
+    const int wait_status = wait_at_most(pid, time_limit, result.timed_out);
 
     set_status(wait_status, result);
     std::ifstream in(log);
@@ -299,23 +310,9 @@ namespace knee_contact
       {
         if (kill_now)
           kill(-pid, SIGKILL);
-        int        wait_status = 0;
-        const auto start       = std::chrono::steady_clock::now();
-        for (;;)
-          {
-            const pid_t done = waitpid(pid, &wait_status, WNOHANG);
-            if (done == pid || (done < 0 && errno != EINTR))
-              break;
-            if (std::chrono::duration<double>(std::chrono::steady_clock::now() -
-                                              start)
-                  .count() > 5)
-              kill(-pid, SIGKILL);
-            std::this_thread::sleep_for(std::chrono::milliseconds(5));
-          }
-        // Its children may outlive it in its group; they must not write on.
-        kill(-pid, SIGKILL);
-        interruption::remove_child(pid);
-        pid = 0;
+        bool      killed      = false;
+        const int wait_status = wait_at_most(pid, 5, killed);
+        pid                   = 0;
         if (result)
           set_status(wait_status, *result);
       }
