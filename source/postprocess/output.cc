@@ -272,6 +272,14 @@ namespace knee_contact
       }
     if (result.exit_code == 0)
       return true;
+    // "no pictures" means none: a drawing cut off at the time limit or by
+    // an error leaves the figures it finished, which would stand beside
+    // results they may not match.
+    std::error_code ignored;
+    for (const auto &entry :
+         std::filesystem::directory_iterator(folder, ignored))
+      if (entry.path().extension() == ".png")
+        std::filesystem::remove(entry.path(), ignored);
     message = describe_failure(result,
                                "python3 " + script_name,
                                output_folder,
