@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
 #include <csignal>
 #include <cstring>
 
@@ -52,38 +53,57 @@ namespace knee_contact
             slot[0] = '\0';
       }
 
-      // Remove the entries of @p folder and the folder itself, with system
-      // calls only (readdir may allocate; getdents64 does not).
-      void
-      remove_folder(const char *folder)
+      // Remove @p folder and everything below it (a friction load path
+      // stages a folder per case, the pictures a folder of their own), with
+      // system calls only: readdir and std::filesystem may allocate,
+      // getdents64, unlinkat and openat do not. Entries of the folder @p
+      // parent names relative to it (AT_FDCWD for a path). The depth is
+      // bounded: our own staging is three levels deep at most, and a
+      // bounded recursion keeps the handler's stack use bounded too (2 kB
+      // a level). Returns whether the folder is gone.
+      bool
+      remove_tree(const int parent, const char *folder, const unsigned depth)
       {
-        const int fd = open(folder, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+        if (depth > 16)
+          return false;
+        const int fd = openat(parent,
+                              folder,
+                              O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
         if (fd >= 0)
           {
-            alignas(8) char buffer[8192];
-            for (;;)
+            // Removing entries while reading the folder may skip some:
+            // read it again until a pass removes nothing.
+            for (bool removed = true; removed;)
               {
-                const long n =
-                  syscall(SYS_getdents64, fd, buffer, sizeof(buffer));
-                if (n <= 0)
-                  break;
-                for (long offset = 0; offset < n;)
-                  {
-                    // struct linux_dirent64: ino (8), off (8), reclen (2),
-                    // type (1), name.
-                    unsigned short length;
-                    std::memcpy(&length, buffer + offset + 16, sizeof(length));
-                    const char *name = buffer + offset + 19;
-                    if (std::strcmp(name, ".") != 0 &&
-                        std::strcmp(name, "..") != 0)
-                      if (unlinkat(fd, name, 0) != 0)
-                        unlinkat(fd, name, AT_REMOVEDIR);
-                    offset += length;
-                  }
+                removed = false;
+                lseek(fd, 0, SEEK_SET);
+                alignas(8) char buffer[2048];
+                long            n;
+                while (
+                  (n = syscall(SYS_getdents64, fd, buffer, sizeof(buffer))) > 0)
+                  for (long offset = 0; offset < n;)
+                    {
+                      // struct linux_dirent64: ino (8), off (8), reclen (2),
+                      // type (1), name.
+                      unsigned short length;
+                      std::memcpy(&length,
+                                  buffer + offset + 16,
+                                  sizeof(length));
+                      const char *name = buffer + offset + 19;
+                      offset += length;
+                      if (std::strcmp(name, ".") == 0 ||
+                          std::strcmp(name, "..") == 0)
+                        continue;
+                      if (unlinkat(fd, name, 0) == 0)
+                        removed = true;
+                      else if ((errno == EISDIR || errno == EPERM) &&
+                               remove_tree(fd, name, depth + 1))
+                        removed = true;
+                    }
               }
             close(fd);
           }
-        rmdir(folder);
+        return unlinkat(parent, folder, AT_REMOVEDIR) == 0;
       }
 
       void
@@ -101,7 +121,7 @@ namespace knee_contact
           }
         for (const auto &folder : folders)
           if (folder[0] != '\0')
-            remove_folder(folder);
+            remove_tree(AT_FDCWD, folder, 0);
         for (const auto &file : files)
           if (file[0] != '\0')
             unlink(file);

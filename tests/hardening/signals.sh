@@ -6,12 +6,16 @@
 # stderr, the previous result set unchanged byte for byte, no staging folder
 # or lock file left and no gmsh temporary folder left. Then two runs at once:
 # the second is refused while the first holds the folder, and the first
-# completes. Usage: signals.sh PROGRAM SCENE (a scene with pictures whose
-# solve prints "active set iteration" lines).
+# completes. With LOAD_PATH_SCENE (a scene with friction), a load path of
+# 1001 cases, each staged in a folder of its own, is interrupted after its
+# third case: nothing may be left beside the result folder.
+# Usage: signals.sh PROGRAM SCENE [LOAD_PATH_SCENE] (SCENE: with pictures,
+# its solve prints "active set iteration" lines).
 set -u
 export LC_ALL=C
 program=$1
 scene=$2
+load_path_scene=${3:-}
 work=$(mktemp -d)
 trap 'kill $(jobs -p) 2>/dev/null; rm -rf "$work"' EXIT
 cd "$work"
@@ -68,6 +72,31 @@ for phase in in_solve writing_output drawing; do
     echo "PASS: SIG$signal $phase: exit $code, result set unchanged, nothing left"
   done
 done
+
+# A load path: a folder per case inside the staging folder (the handler
+# removes the whole tree, not one level).
+if [ -n "$load_path_scene" ]; then
+  path_folder="load path"
+  sed -e 's/^  set Write files .*//' -e 's/^  set Terminal .*//' \
+    -e 's/^  set Folder .*//' "$load_path_scene" >path.prm
+  printf 'subsection Load cases\n  set Values of t = 0:0.001:1\nend\n' >>path.prm
+  printf 'subsection Output\n  set Folder = %s\nend\n' "$path_folder" >>path.prm
+  third_case() { compgen -G ".$path_folder.new-*/case_002/*" >/dev/null; }
+  for signal in INT TERM; do
+    "$program" path.prm >run.log 2>run.err &
+    pid=$!
+    wait_for 120 third_case || fail "load path: the third case never staged"
+    kill -$signal $pid
+    wait $pid
+    code=$?
+    expected=$((128 + $(kill -l $signal)))
+    [ $code -eq $expected ] || fail "load path, SIG$signal: exit code $code, expected $expected"
+    [ "$(ls -A | grep -c "^\.load path")" -eq 0 ] ||
+      fail "load path, SIG$signal: staging folder or lock left: $(ls -A)"
+    [ ! -e "$path_folder" ] || fail "load path, SIG$signal: a result folder appeared"
+    echo "PASS: SIG$signal during a load path (cases staged in folders): nothing left"
+  done
+fi
 
 # Two runs on one folder: the second is refused with one line while the
 # first lives, and the first still completes. The first is stopped

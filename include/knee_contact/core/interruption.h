@@ -28,7 +28,7 @@ namespace knee_contact
     install();
 
     /**
-     * Remove @p folder (its files and the folder; one level deep) if a
+     * Remove @p folder (everything below it, the folder itself) if a
      * signal arrives. At most a few folders can be registered.
      */
     void
