@@ -46,6 +46,9 @@ namespace knee_contact
       AssertThrow(extension == ".prm" || extension == ".json",
                   ExcMessage("scene file '" + scene_file +
                              "' must end in .prm or .json"));
+      // The file's size and nesting first: ParameterHandler's cost grows
+      // with the square of the nesting (see SceneOutline).
+      const SceneOutline outline(scene_file);
       try
         {
           prm.parse_input(scene_file, "", skip_undefined);

@@ -48,14 +48,37 @@ namespace knee_contact
     fs::path path = fs::path(folder_name).lexically_normal();
     if (!path.has_filename() && path.has_parent_path())
       path = path.parent_path();
-    const std::string name = path.filename().string();
-    if (name.empty() || name == "." || name == "..")
+    if (path.filename().empty() || path.filename() == "." ||
+        path.filename() == "..")
       throw error("'" + folder_name +
                   "' must name a folder of its own (not '.', '..' or '/')");
-    folder                = path.string();
-    const fs::path parent = path.has_parent_path() ? path.parent_path() : ".";
-
+    // A symbolic link (results -> /data/run7) stays a link: the result set
+    // is swapped in at its target, beside which staging and lock live, so
+    // two runs through different names still lock the same folder.
     std::error_code code;
+    for (unsigned int hops = 0; fs::is_symlink(fs::symlink_status(path, code));
+         ++hops)
+      {
+        if (hops == 40)
+          throw error("'" + folder_name +
+                      "' is a symbolic link that leads round in a circle");
+        const fs::path target = fs::read_symlink(path, code);
+        if (code)
+          throw error("cannot read the link '" + path.string() +
+                      "': " + code.message());
+        path = (target.is_absolute() ? target : path.parent_path() / target)
+                 .lexically_normal();
+        if (!path.has_filename() && path.has_parent_path())
+          path = path.parent_path();
+        if (path.filename().empty() || path.filename() == "." ||
+            path.filename() == "..")
+          throw error("'" + folder_name + "' links to '" + path.string() +
+                      "', which does not name a folder of its own");
+      }
+    folder                 = path.string();
+    const std::string name = path.filename().string();
+    const fs::path parent  = path.has_parent_path() ? path.parent_path() : ".";
+
     fs::create_directories(parent, code);
     if (code)
       throw error("cannot create '" + parent.string() + "': " + code.message());
@@ -65,6 +88,15 @@ namespace knee_contact
       throw error("'" + folder +
                   "' holds files that are not a knee_contact result set; "
                   "choose a new or empty folder (it would be replaced)");
+    // A folder without write permission is one the user protected (and
+    // the previous set could not be removed after the swap): refused, for
+    // root too, who would pass access(W_OK).
+    struct stat status;
+    if (stat(folder.c_str(), &status) == 0 && S_ISDIR(status.st_mode) &&
+        ((status.st_mode & 0222) == 0 || access(folder.c_str(), W_OK) != 0))
+      throw error("'" + folder +
+                  "' is read-only; make it writable (chmod u+w) to replace "
+                  "its results, or choose another folder");
 
     // One run per folder. flock dies with the process, so a killed run
     // never blocks the next one; the inode check catches a lock file that

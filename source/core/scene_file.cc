@@ -43,6 +43,25 @@ namespace knee_contact
     std::ifstream in(scene_file);
     if (!in)
       throw std::runtime_error("cannot open scene file '" + scene_file + "'");
+    // Limits of a scene file, far beyond any scene (the examples nest three
+    // levels deep and take a few kB), that bound what a hostile file costs:
+    // deal.II's ParameterHandler and Boost's JSON reader take time and
+    // memory that grow with the square of the nesting and recurse on the
+    // stack (30 000 levels: 15 s and 1.1 GB).
+    constexpr unsigned int   max_depth = 16;
+    constexpr std::uintmax_t max_size  = 16u << 20;
+    std::error_code          code;
+    const std::uintmax_t size = std::filesystem::file_size(scene_file, code);
+    if (!code && size > max_size)
+      throw std::runtime_error(
+        scene_file + ": " + std::to_string(size >> 20) +
+        " MB; a scene file is at most " + std::to_string(max_size >> 20) +
+        " MB (meshes and data go in files of their own)");
+    const auto too_deep = [&](const std::string &where) {
+      return std::runtime_error(
+        scene_file + where + ": subsections nested deeper than " +
+        std::to_string(max_depth) + " levels (scenes need 3)");
+    };
 
     if (std::filesystem::path(scene_file).extension() == ".json")
       {
@@ -55,7 +74,8 @@ namespace knee_contact
                                   nlohmann::json::parse_event_t    event,
                                   [[maybe_unused]] nlohmann::json &value) {
           using event_t = nlohmann::json::parse_event_t;
-          (void)depth;
+          if (depth > int(max_depth))
+            throw too_deep("");
           if (event == event_t::key)
             {
               const std::string key = normalise(value.get<std::string>());
@@ -124,6 +144,8 @@ namespace knee_contact
         statement = normalise(statement + trimmed);
         if (statement.rfind("subsection ", 0) == 0)
           {
+            if (path.size() == max_depth)
+              throw too_deep(":" + std::to_string(first));
             path.push_back(normalise(statement.substr(11)));
             subsections.insert(join(path));
           }

@@ -1,5 +1,6 @@
 #include <knee_contact/core/input.h>
 #include <knee_contact/core/interruption.h>
+#include <knee_contact/core/memory.h>
 #include <knee_contact/mesh/gmsh_input.h>
 #include <knee_contact/mesh/mesh.h>
 #include <knee_contact/mesh/mesh_readers.h>
@@ -298,39 +299,11 @@ namespace knee_contact
       }
     attach_manifolds(triangulation);
 
-    // Refuse early a mesh the machine cannot hold: about 8 kB per cell in
-    // 2D for matrix, factorisation and vectors (measured: 1.8 GB for
-    // 236 544 cells with contact); in 3D the factor fills in more:
-    // measured 1.3 GB peak for 32 768 hexahedra (1.1e5 DoFs), 35 kB per
-    // cell, and 21 kB at 4 096 (about cells^(1/4)); estimated with
-    // cells^(1/3) above 3.3e4 to stay on the safe side.
-    const double n_cells =
-      triangulation.n_active_cells() * std::pow(double(1u << dim), n_refine);
-    const double needed =
-      (dim == 2 ? 8e3 : 3.5e4 * std::max(1., std::cbrt(n_cells / 3.3e4))) *
-      n_cells;
-    double available = 0;
-    {
-      std::ifstream meminfo("/proc/meminfo");
-      std::string   key;
-      double        kb = 0;
-      while (meminfo >> key >> kb)
-        {
-          if (key == "MemAvailable:")
-            available = kb * 1024;
-          meminfo.ignore(256, '\n');
-        }
-    }
-    AssertThrow(available == 0 || needed < available,
-                ExcMessage(
-                  "Mesh/Global refinements: " + std::to_string(n_refine) +
-                  " refinements give about " +
-                  std::to_string(static_cast<long long>(n_cells)) +
-                  " cells, needing about " +
-                  std::to_string(static_cast<long long>(needed / 1e9)) +
-                  " GB; this machine has " +
-                  std::to_string(available / 1e9).substr(0, 5) +
-                  " GB available"));
+    check_run_fits(dim,
+                   triangulation.n_active_cells() *
+                     std::pow(double(1u << dim), n_refine),
+                   "Mesh/Global refinements: " + std::to_string(n_refine) +
+                     " refinements");
     triangulation.refine_global(n_refine);
     if (n_refine > 0)
       check_cells(triangulation);
@@ -448,6 +421,44 @@ namespace knee_contact
 
 
   // The members that read files and make rectangles are in mesh_files.cc.
+  double
+  estimated_run_bytes(const unsigned int dim, const double n_cells)
+  {
+    // About 8 kB per cell in 2D for matrix, factorisation and vectors
+    // (measured: 1.8 GB for 236 544 cells with contact); in 3D the factor
+    // fills in more: measured 1.3 GB peak for 32 768 hexahedra (1.1e5
+    // DoFs), 35 kB per cell, and 21 kB at 4 096 (about cells^(1/4));
+    // estimated with cells^(1/3) above 3.3e4 to stay on the safe side.
+    return (dim == 2 ? 8e3 : 3.5e4 * std::max(1., std::cbrt(n_cells / 3.3e4))) *
+           n_cells;
+  }
+
+
+
+  void
+  check_run_fits(const unsigned int dim,
+                 const double       n_cells,
+                 const std::string &what)
+  {
+    std::string  limit;
+    const double available = memory::available(limit);
+    const double needed    = estimated_run_bytes(dim, n_cells);
+    const auto   gigabytes = [](const double bytes) {
+      std::ostringstream out;
+      out << std::setprecision(3) << bytes / 1e9 << " GB";
+      return out.str();
+    };
+    std::ostringstream cells;
+    cells << std::setprecision(3) << n_cells;
+    AssertThrow(needed < available,
+                ExcMessage(what + ": about " + cells.str() +
+                           " cells need about " + gigabytes(needed) + "; " +
+                           gigabytes(available) + " are available (" + limit +
+                           ")"));
+  }
+
+
+
   template class MeshInput<2>;
   template class MeshInput<3>;
 } // namespace knee_contact

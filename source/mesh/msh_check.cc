@@ -2,6 +2,7 @@
 // GridIn reads it: gmsh_input::check_msh().
 #include <knee_contact/core/input.h>
 #include <knee_contact/mesh/gmsh_input.h>
+#include <knee_contact/mesh/mesh.h>
 
 #include <algorithm>
 #include <cctype>
@@ -14,6 +15,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <unordered_set>
+#include <vector>
 
 namespace knee_contact
 {
@@ -58,10 +60,20 @@ namespace knee_contact
         bool
         next(std::vector<std::string> &tokens)
         {
+          // At most max_line_length characters: a file of one endless line
+          // (a sparse file of zeros) is not read into memory.
           std::string line;
-          if (!std::getline(in, line))
+          buffer.resize(max_line_length + 1);
+          in.getline(buffer.data(), buffer.size());
+          const std::streamsize n = in.gcount();
+          if (in.bad() || (n == 0 && in.eof()))
             return false;
           ++line_number;
+          if (in.fail() && !in.eof())
+            fail("a line longer than " +
+                 std::to_string(max_line_length / 1024) +
+                 " kB (not a .msh file?)");
+          line.assign(buffer.data(), in.eof() ? n : n - 1);
           tokens.clear();
           std::istringstream words(line);
           for (std::string w; words >> w;)
@@ -83,6 +95,19 @@ namespace knee_contact
               " fields" +
               (n_min == n_max ? " instead of " + std::to_string(n_min) : ""));
           return tokens;
+        }
+
+        // Nodes to come: the run they ask for must fit in memory (a mesh
+        // has at least half as many cells as nodes), checked before they
+        // are read and stored.
+        void
+        check_fits(const unsigned long long n_nodes) const
+        {
+          check_run_fits(2,
+                         n_nodes / 2.,
+                         "Mesh/File: '" + file + "' line " +
+                           std::to_string(line_number) + ": " +
+                           std::to_string(n_nodes) + " nodes");
         }
 
         // A count; each entry takes at least a few bytes, so a count
@@ -166,9 +191,12 @@ namespace knee_contact
         const std::string file;
 
       private:
-        std::ifstream      in;
-        unsigned long long size        = 0;
-        unsigned long      line_number = 0;
+        // The longest line read.
+        static constexpr std::size_t max_line_length = 1 << 20;
+        std::ifstream                in;
+        std::vector<char>            buffer;
+        unsigned long long           size        = 0;
+        unsigned long                line_number = 0;
       };
 
 
@@ -250,6 +278,7 @@ namespace knee_contact
                 const auto n =
                   reader.count(reader.expect(1, 1, "the node count")[0],
                                "node count");
+                reader.check_fits(n);
                 for (unsigned long long i = 0; i < n; ++i)
                   {
                     t = reader.expect(4, 4, "a node 'tag x y z'");
@@ -379,9 +408,10 @@ namespace knee_contact
                 t = reader.expect(4, 4, "'numEntityBlocks numNodes ...'");
                 reader.tag(t[2], "smallest node tag");
                 reader.tag(t[3], "largest node tag");
-                const auto         n_blocks = reader.count(t[0], "block count");
-                const auto         n_total  = reader.count(t[1], "node count");
-                unsigned long long n_read   = 0;
+                const auto n_blocks = reader.count(t[0], "block count");
+                const auto n_total  = reader.count(t[1], "node count");
+                reader.check_fits(n_total);
+                unsigned long long n_read = 0;
                 for (unsigned long long b = 0; b < n_blocks; ++b)
                   {
                     t            = reader.expect(4, 4, "a node block header");

@@ -1,9 +1,8 @@
+#include <knee_contact/core/memory.h>
 #include <knee_contact/solver/contact_system.h>
 #include <knee_contact/solver/sparse_cholesky.h>
 
 #include <deal.II/base/timer.h>
-
-#include <sys/resource.h>
 
 #include <algorithm>
 #include <cmath>
@@ -18,89 +17,7 @@ namespace knee_contact
 {
   namespace
   {
-    /** The first number after @p key in @p file [bytes], or -1. */
-    double
-    read_field(const std::string &file, const std::string &key, double unit)
-    {
-      std::ifstream in(file);
-      std::string   line;
-      while (std::getline(in, line))
-        if (line.compare(0, key.size(), key) == 0)
-          {
-            std::istringstream fields(line.substr(key.size()));
-            double             value = -1;
-            if (fields >> value)
-              return value * unit;
-          }
-      return -1;
-    }
-
-    /** A file holding one number ("max": no limit) [bytes], or -1. */
-    double
-    read_number(const std::string &file)
-    {
-      std::ifstream in(file);
-      std::string   word;
-      if (!(in >> word) || word == "max")
-        return -1;
-      try
-        {
-          return std::stod(word);
-        }
-      catch (...)
-        {
-          return -1;
-        }
-    }
-
-    /**
-     * Bytes this process can still allocate before the kernel refuses or
-     * kills it: the least of MemAvailable, the cgroup's limit (v2 or v1)
-     * less its usage, and the address-space limit (ulimit -v) less the
-     * process's mapped size. @p which names the binding limit.
-     */
-    double
-    available_memory(std::string &which)
-    {
-      double available = std::numeric_limits<double>::max();
-      which            = "no limit found";
-      const auto take  = [&](const double value, const std::string &name) {
-        if (value >= 0 && value < available)
-          {
-            available = value;
-            which     = name;
-          }
-      };
-      take(read_field("/proc/meminfo", "MemAvailable:", 1024.), "MemAvailable");
-      for (const auto &[limit, usage] :
-           {std::pair<std::string, std::string>{
-              "/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"},
-            {"/sys/fs/cgroup/memory/memory.limit_in_bytes",
-             "/sys/fs/cgroup/memory/memory.usage_in_bytes"}})
-        {
-          const double max = read_number(limit), used = read_number(usage);
-          if (max >= 0 && max < 1e18 && used >= 0)
-            take(std::max(0., max - used), "the cgroup's memory limit");
-        }
-      rlimit address_space;
-      if (getrlimit(RLIMIT_AS, &address_space) == 0 &&
-          address_space.rlim_cur != RLIM_INFINITY)
-        {
-          const double mapped =
-            read_field("/proc/self/status", "VmSize:", 1024.);
-          take(std::max(0., double(address_space.rlim_cur) - mapped),
-               "the address-space limit (ulimit -v)");
-        }
-      return available;
-    }
-
-    std::string
-    megabytes(const double bytes)
-    {
-      std::ostringstream out;
-      out << std::fixed << std::setprecision(0) << bytes / 1048576. << " MB";
-      return out.str();
-    }
+    using memory::megabytes;
 
     std::string
     gigaflops(const double flops)
@@ -225,7 +142,7 @@ namespace knee_contact
                                 fl;
 
     std::string  limit;
-    const double available = available_memory(limit);
+    const double available = memory::available(limit);
     // Head room for the solution vectors and the results that follow.
     const auto fits = [&](const double bytes) {
       return bytes <= 0.8 * available;
@@ -235,9 +152,8 @@ namespace knee_contact
     figures["estimated_sparse_Gflop"]    = sparse_flops / 1e9;
     figures["estimated_condensed_Gflop"] = condensed_flops / 1e9;
     figures["available_MB"]              = available / 1048576.;
-    figures["process_virtual_MB"] =
-      read_field("/proc/self/status", "VmSize:", 1024.) / 1048576.;
-    figures["contact_unknowns"] = k;
+    figures["process_virtual_MB"]        = memory::process_virtual() / 1048576.;
+    figures["contact_unknowns"]          = k;
 
     SolverPath  path = requested;
     std::string reason;

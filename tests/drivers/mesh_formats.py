@@ -5,7 +5,8 @@ tests/meshes/patch_stack.geo is meshed by gmsh (triangles; with
 -setnumber mixed 1 the upper block mostly quadrilaterals: a mixed mesh) and
 the .msh is written out again, by this script, as an Abaqus input deck
 (element sets per body, *Nset for the outer sides, element-face *Surface
-for the contact sides, named in the scene; and gmsh writes its own .inp
+for the contact sides, named in the scene; also with the node and element
+data in files of their own, read through *Include and INPUT=; and gmsh writes its own .inp
 with line elements for the sides), as a legacy VTK file and as
 VTK XML .vtu files in the four encodings VTK and ParaView write (ascii,
 base64, base64 of zlib blocks, raw appended; MaterialID of cells and of
@@ -128,19 +129,34 @@ def read_msh22(path):
     return nodes, cells, lines
 
 
-def write_inp(path, nodes, cells, lines):
+def write_inp(path, nodes, cells, lines, split=False):
     """Abaqus deck: bodies as element sets BODY_1, BODY_2 (also given in
     *Element lines by type), outer sides as node sets, contact sides as
-    element-face surfaces."""
-    out = ["*Heading", "** written by tests/drivers/mesh_formats.py", "*Node"]
-    out += ["%d, %.17g, %.17g" % (t, x, y) for t, (x, y) in nodes.items()]
+    element-face surfaces. With split, the data lines in files of their
+    own as large models are written: "*Node" followed by "*Include,
+    input=..." (the nodes file), "*Element, type=..., input=..."."""
+    base = os.path.splitext(path)[0]
+
+    def data(keyword, suffix, data_lines):
+        if not split:
+            return [keyword] + data_lines
+        name = base + suffix
+        with open(name, "w") as f:
+            f.write("\n".join(data_lines) + "\n")
+        if keyword == "*Node":
+            return [keyword, "*Include, input=%s" % os.path.basename(name)]
+        return [keyword + ", input=%s" % os.path.basename(name)]
+
+    out = ["*Heading", "** written by tests/drivers/mesh_formats.py"]
+    out += data("*Node", "_nodes.inp",
+                ["%d, %.17g, %.17g" % (t, x, y) for t, (x, y) in nodes.items()])
     for n, kind in ((3, "CPE3"), (4, "CPE4R")):
         numbered = [(e + 1, c) for e, c in enumerate(cells)
                     if len(c[1]) == n]
         if numbered:
-            out.append("*Element, type=%s" % kind)
-            out += ["%d, %s" % (e, ", ".join(map(str, c[1])))
-                    for e, c in numbered]
+            out += data("*Element, type=%s" % kind, "_%s.inp" % kind,
+                        ["%d, %s" % (e, ", ".join(map(str, c[1])))
+                         for e, c in numbered])
     for body in sorted({c[0] for c in cells}):
         out.append("*Elset, elset=BODY_%d" % body)
         out += ["%d," % (e + 1) for e, c in enumerate(cells) if c[0] == body]
@@ -521,6 +537,14 @@ def main():
                 assert os.path.getsize(os.path.join(
                     folder, kind + "_inp", picture)) > 1000, picture
             failures += compare(kind + ".inp", reference, abaqus)
+            # Nodes through *Include inside the *Node block, elements
+            # through *Element, input=: the same mesh.
+            split_inp = os.path.join(folder, kind + "_split.inp")
+            write_inp(split_inp, nodes, cells, lines, split=True)
+            failures += compare(kind + ".inp, nodes by *Include, elements "
+                                "by input=", reference,
+                                run(binary, folder, kind + "_split_inp",
+                                    split_inp, abaqus_sets))
             failures += compare(kind + ".vtk", reference,
                                 run(binary, folder, kind + "_vtk", vtk,
                                     no_sets))

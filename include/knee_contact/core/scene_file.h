@@ -19,7 +19,9 @@ namespace knee_contact
   public:
     /**
      * Read @p scene_file; throws a one-line error naming the file, line and
-     * parameter of a repeated `set` or a repeated JSON key.
+     * parameter of a repeated `set` or a repeated JSON key, and refuses a
+     * file beyond the limits that bound what parsing it costs: 16 MB, and
+     * subsections (JSON objects and arrays) nested 16 levels deep.
      */
     explicit SceneOutline(const std::string &scene_file);
 

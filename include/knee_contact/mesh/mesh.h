@@ -240,6 +240,24 @@ namespace knee_contact
   template <int dim>
   void
   check_cells(const Triangulation<dim> &triangulation);
+
+  /**
+   * The memory a run on @p n_cells cells in @p dim dimensions needs with
+   * the direct solver paths [bytes]: matrix, factorisation and vectors,
+   * measured (see mesh.cc).
+   */
+  double
+  estimated_run_bytes(unsigned int dim, double n_cells);
+
+  /**
+   * Refuse, before anything of the size is allocated, a mesh of @p n_cells
+   * cells that the memory available to the process (memory::available())
+   * cannot hold: "<what>: about N cells need about X GB; Y GB are
+   * available (MemAvailable)". @p what names the file and line or the
+   * parameter that asks for the size.
+   */
+  void
+  check_run_fits(unsigned int dim, double n_cells, const std::string &what);
 } // namespace knee_contact
 
 #endif

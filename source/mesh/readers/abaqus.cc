@@ -43,7 +43,10 @@ namespace knee_contact
           return false;
         }
 
-        /** Continue with @p name (relative to the current file's folder). */
+        /**
+         * Continue with @p name (relative to the current file's folder),
+         * then with the rest of the current file: *Include and INPUT=.
+         */
         void
         include(const std::string &name)
         {
@@ -56,11 +59,11 @@ namespace knee_contact
           for (const auto &file : files)
             if (std::filesystem::weakly_canonical(file->file) ==
                 std::filesystem::weakly_canonical(path))
-              fail("*Include of '" + name + "', which includes itself");
+              fail("INPUT=" + name + ", which includes itself");
           if (files.size() >= 8)
-            fail("*Include nested more than 8 deep");
+            fail("INPUT= files (*Include) nested more than 8 deep");
           if (!std::filesystem::is_regular_file(path))
-            fail("*Include: cannot open '" + path + "'");
+            fail("INPUT=" + name + ": cannot open '" + path + "'");
           open(path);
         }
 
@@ -220,23 +223,34 @@ namespace knee_contact
       }
 
       /**
-       * The file of an *Include line: its INPUT= as written (a path keeps
-       * its case).
+       * The INPUT= of a keyword line as written (a path keeps its case), or
+       * "".
        */
       std::string
-      include_input(const std::vector<std::string> &keyword_fields,
-                    const Deck                     &deck)
+      input_of(const std::vector<std::string> &keyword_fields)
       {
         for (std::size_t i = 1; i < keyword_fields.size(); ++i)
           {
             const auto equal = keyword_fields[i].find('=');
             if (equal != std::string::npos &&
-                upper(trim(keyword_fields[i].substr(0, equal))) == "INPUT" &&
-                !trim(keyword_fields[i].substr(equal + 1)).empty())
+                upper(trim(keyword_fields[i].substr(0, equal))) == "INPUT")
               return trim(keyword_fields[i].substr(equal + 1));
           }
-        deck.fail("*Include without INPUT=");
+        return "";
       }
+
+      /** The file of an *Include line. */
+      std::string
+      include_input(const std::vector<std::string> &keyword_fields,
+                    const Deck                     &deck)
+      {
+        const std::string input = input_of(keyword_fields);
+        if (input.empty())
+          deck.fail("*Include without INPUT=");
+        return input;
+      }
+
+
 
       std::vector<long long>
       sorted(std::vector<long long> nodes)
@@ -392,8 +406,26 @@ namespace knee_contact
                 text += trim(more);
               const auto        keyword_fields = fields(text);
               const std::string keyword        = upper(keyword_fields[0]);
-              block                            = "";
-              set_instance                     = "";
+              // *Include is textual: the file's lines stand in place of
+              // this one, so a block (*Node, *Element, ...) goes on in it.
+              if (keyword == "*INCLUDE")
+                {
+                  deck.include(include_input(keyword_fields, deck));
+                  continue;
+                }
+              // INPUT= on another keyword (*Node, input=nodes.inp): the
+              // keyword's data lines are that file's; the handlers below
+              // read no lines themselves but *Instance's.
+              if (const std::string input = input_of(keyword_fields);
+                  !input.empty())
+                {
+                  if (keyword == "*INSTANCE")
+                    deck.fail("*Instance with INPUT=: knee_contact reads "
+                              "an instance's data lines in the deck");
+                  deck.include(input);
+                }
+              block        = "";
+              set_instance = "";
               // A *Material's definition is the keywords up to the next
               // that is not one of its options.
               const std::set<std::string> material_options = {"*ELASTIC",
@@ -447,11 +479,7 @@ namespace knee_contact
                             " named '" + name + "'");
                 return name;
               };
-              if (keyword == "*INCLUDE")
-                {
-                  deck.include(include_input(keyword_fields, deck));
-                }
-              else if (keyword == "*PART")
+              if (keyword == "*PART")
                 {
                   scope = &parts[new_name("*Part", parts)];
                 }

@@ -1,3 +1,5 @@
+#include <knee_contact/core/memory.h>
+#include <knee_contact/mesh/mesh.h>
 #include <knee_contact/mesh/readers/line_reader.h>
 
 #include <algorithm>
@@ -31,16 +33,9 @@ namespace knee_contact
       public:
         explicit LegacyFile(const std::string &file)
           : file(file)
-        {
-          std::ifstream in(file, std::ios::binary);
-          AssertThrow(in.good(),
-                      ExcMessage("Mesh/File: cannot open '" + file + "'"));
-          const std::uintmax_t size = std::filesystem::file_size(file);
-          text.resize(size);
-          in.read(text.data(), size);
-          AssertThrow(in.good() || in.eof(),
-                      ExcMessage("Mesh/File: cannot read '" + file + "'"));
-        }
+          , mapped(file)
+          , text(mapped.text())
+        {}
 
         [[noreturn]] void
         fail(const std::string &what) const
@@ -50,6 +45,14 @@ namespace knee_contact
                        std::to_string(line_number) + ": " + what));
         }
 
+        /** "Mesh/File: 'f.vtk' line 12: @p what". */
+        std::string
+        where(const std::string &what) const
+        {
+          return "Mesh/File: '" + file + "' line " +
+                 std::to_string(line_number) + ": " + what;
+        }
+
         /** The next line, without its end; false at the end of the file. */
         bool
         line(std::string &result)
@@ -57,10 +60,14 @@ namespace knee_contact
           if (at >= text.size())
             return false;
           const auto end = std::min(text.find('\n', at), text.size());
-          result         = text.substr(at, end - at);
+          line_number    = newlines + 1;
+          if (end - at > max_line_length)
+            fail("a line longer than " +
+                 std::to_string(max_line_length / 1024) +
+                 " kB where a keyword should be (not a VTK file?)");
+          result = std::string(text.substr(at, end - at));
           if (!result.empty() && result.back() == '\r')
             result.pop_back();
-          line_number = newlines + 1;
           if (end < text.size())
             ++newlines;
           at = std::min(end + 1, text.size());
@@ -94,7 +101,7 @@ namespace knee_contact
             ++p;
           if (p >= text.size())
             return false;
-          return upper(text.substr(p, word.size())) == word &&
+          return upper(std::string(text.substr(p, word.size()))) == word &&
                  (p + word.size() == text.size() ||
                   std::isspace(
                     static_cast<unsigned char>(text[p + word.size()])));
@@ -142,12 +149,15 @@ namespace knee_contact
 
         /**
          * @p n values of the VTK data type @p type, as doubles (ids and
-         * counts are integers far below 2^53).
+         * counts are integers far below 2^53); an array that is not @p keep
+         * is read past (checked, not stored). The doubles are allocated
+         * only if the memory available holds them.
          */
         std::vector<double>
         values(const std::size_t  n,
                const std::string &type,
-               const std::string &section)
+               const std::string &section,
+               const bool         keep = true)
         {
           // Bytes per value in BINARY files; "long" is 8 bytes as VTK and
           // meshio write it on 64-bit Linux.
@@ -172,16 +182,32 @@ namespace knee_contact
                  "' (knee_contact reads char, short, int, long, their "
                  "unsigned kinds, vtktypeint32/64, float and double)");
           std::vector<double> result;
+          const auto          allocate = [&]() {
+            if (!keep)
+              return;
+            std::string  limit;
+            const double available = memory::available(limit);
+            if (8. * n > 0.8 * available)
+              fail(section + ": " + std::to_string(n) + " values need " +
+                   memory::megabytes(8. * n) + "; " +
+                   memory::megabytes(available) + " are available (" + limit +
+                   ")");
+            result.reserve(n);
+          };
           if (binary)
             {
               const std::size_t bytes = size->second;
               if (n > (text.size() - at) / bytes)
                 fail(section + ": " + std::to_string(n) + " values of type " +
                      type + " are more than the rest of the file holds");
-              result.resize(n);
-              for (std::size_t i = 0; i < n; ++i)
-                result[i] =
-                  binary_value(text.data() + at + i * bytes, type, bytes);
+              allocate();
+              if (keep)
+                {
+                  const Kind kind = kind_of(type);
+                  for (std::size_t i = 0; i < n; ++i)
+                    result.push_back(
+                      binary_value(text.data() + at + i * bytes, kind, bytes));
+                }
               at += n * bytes;
             }
           else
@@ -189,7 +215,7 @@ namespace knee_contact
               if (n > text.size() - at)
                 fail(section + ": " + std::to_string(n) +
                      " values are more than the rest of the file holds");
-              result.reserve(n);
+              allocate();
               for (std::size_t i = 0; i < n; ++i)
                 {
                   const std::string word = ascii_word();
@@ -200,7 +226,8 @@ namespace knee_contact
                   const auto value = input::number(word);
                   if (!value)
                     fail("'" + word + "' is not a finite number");
-                  result.push_back(*value);
+                  if (keep)
+                    result.push_back(*value);
                 }
             }
           return result;
@@ -231,7 +258,16 @@ namespace knee_contact
         }
 
         const std::string file;
-        bool              binary = false;
+
+      private:
+        // Declared before text, which views it.
+        MappedFile mapped;
+
+      public:
+        bool binary = false;
+        /** The longest keyword line and ASCII value read. */
+        static constexpr std::size_t max_line_length = 1 << 20,
+                                     max_word_length = 256;
         /** The line of what was read last, for messages. */
         unsigned long line_number = 0;
 
@@ -245,35 +281,57 @@ namespace knee_contact
           const std::size_t start = at;
           while (at < text.size() &&
                  !std::isspace(static_cast<unsigned char>(text[at])))
-            ++at;
-          return text.substr(start, at - start);
+            if (++at - start > max_word_length)
+              fail("a word of more than " + std::to_string(max_word_length) +
+                   " characters where a number should be");
+          return std::string(text.substr(start, at - start));
+        }
+
+        enum class Kind
+        {
+          floating,
+          double_precision,
+          signed_integer,
+          unsigned_integer
+        };
+
+        static Kind
+        kind_of(const std::string &type)
+        {
+          if (type == "float")
+            return Kind::floating;
+          if (type == "double")
+            return Kind::double_precision;
+          return type == "char" || type == "short" || type == "int" ||
+                     type == "long" || type == "vtktypeint32" ||
+                     type == "vtktypeint64"
+                   ? Kind::signed_integer
+                   : Kind::unsigned_integer;
         }
 
         static double
         binary_value(const char        *data,
-                     const std::string &type,
+                     const Kind         kind,
                      const unsigned int bytes)
         {
           // Big-endian, as the format defines.
           std::uint64_t bits = 0;
           for (unsigned int b = 0; b < bytes; ++b)
             bits = (bits << 8) | static_cast<unsigned char>(data[b]);
-          if (type == "float")
+          if (kind == Kind::floating)
             {
               const auto u = static_cast<std::uint32_t>(bits);
               float      f;
               std::memcpy(&f, &u, 4);
               return f;
             }
-          if (type == "double")
+          if (kind == Kind::double_precision)
             {
               double d;
               std::memcpy(&d, &bits, 8);
               return d;
             }
-          const bool is_signed =
-            type == "char" || type == "short" || type == "int" ||
-            type == "long" || type == "vtktypeint32" || type == "vtktypeint64";
+          const bool is_signed = kind == Kind::signed_integer;
           if (is_signed && bytes < 8 && (bits >> (8 * bytes - 1)) != 0)
             return static_cast<double>(static_cast<std::int64_t>(bits) -
                                        (std::int64_t(1) << (8 * bytes)));
@@ -282,8 +340,8 @@ namespace knee_contact
           return static_cast<double>(bits);
         }
 
-        std::string text;
-        std::size_t at = 0;
+        std::string_view text;
+        std::size_t      at = 0;
         /** Line ends before at (binary data are not counted). */
         unsigned long newlines = 0;
       };
@@ -293,8 +351,8 @@ namespace knee_contact
       /**
        * Read the arrays of the FIELD whose keyword line is @p words, each of
        * @p n tuples (any number if @p n is std::size_t(-1): a field of the
-       * whole data set), and give each to @p keep (name, components,
-       * values).
+       * whole data set), and give each that is @p wanted (by name) to
+       * @p keep (name, components, values); without @p keep none is kept.
        */
       void
       read_field(LegacyFile                                        &vtk,
@@ -302,7 +360,8 @@ namespace knee_contact
                  const std::size_t                                  n,
                  const std::function<void(const std::string &,
                                           const unsigned int,
-                                          std::vector<double> &&)> &keep)
+                                          std::vector<double> &&)> &keep,
+                 const std::function<bool(const std::string &)>    &wanted)
       {
         if (words.size() < 3)
           vtk.fail("FIELD needs a name and an array count");
@@ -323,11 +382,15 @@ namespace knee_contact
                 (n_tuples > 0 && n_components > std::size_t(-1) / n_tuples))
               vtk.fail("FIELD array '" + array[0] + "' has " + array[1] +
                        " components");
-            keep(array[0],
-                 static_cast<unsigned int>(n_components),
-                 vtk.values(n_components * n_tuples,
-                            array[3],
-                            "FIELD array " + array[0]));
+            // Arrays nobody keeps are read past, not stored.
+            auto values = vtk.values(n_components * n_tuples,
+                                     array[3],
+                                     "FIELD array " + array[0],
+                                     keep != nullptr && wanted(array[0]));
+            if (keep != nullptr && wanted(array[0]))
+              keep(array[0],
+                   static_cast<unsigned int>(n_components),
+                   std::move(values));
             vtk.skip_metadata();
           }
       }
@@ -347,8 +410,12 @@ namespace knee_contact
                       std::string              &id_name,
                       std::vector<std::string> &next_section)
       {
-        const auto &names = id_field_names();
-        const auto  keep  = [&](const std::string    &name,
+        const auto &names  = id_field_names();
+        const auto  wanted = [&](const std::string &name) {
+          return cells &&
+                 std::find(names.begin(), names.end(), name) != names.end();
+        };
+        const auto keep = [&](const std::string    &name,
                               const unsigned int    n_components,
                               std::vector<double> &&values) {
           const auto rank = std::find(names.begin(), names.end(), name);
@@ -386,11 +453,12 @@ namespace knee_contact
                 const auto table = vtk.keyword_line("LOOKUP_TABLE");
                 if (upper(table[0]) != "LOOKUP_TABLE")
                   vtk.fail("expected LOOKUP_TABLE, found '" + table[0] + "'");
-                keep(words[1],
-                     n_components,
-                     vtk.values(n * n_components,
-                                words[2],
-                                "SCALARS " + words[1]));
+                auto values = vtk.values(n * n_components,
+                                         words[2],
+                                         "SCALARS " + words[1],
+                                         wanted(words[1]));
+                if (wanted(words[1]))
+                  keep(words[1], n_components, std::move(values));
                 vtk.skip_metadata();
               }
             else if (kind == "VECTORS" || kind == "NORMALS" ||
@@ -398,11 +466,14 @@ namespace knee_contact
               {
                 if (words.size() < 3)
                   vtk.fail(kind + " needs a name and a data type");
-                vtk.values(n * (kind == "TENSORS" ? 9 : 3), words[2], kind);
+                vtk.values(n * (kind == "TENSORS" ? 9 : 3),
+                           words[2],
+                           kind,
+                           false);
                 vtk.skip_metadata();
               }
             else if (kind == "FIELD")
-              read_field(vtk, words, n, keep);
+              read_field(vtk, words, n, keep, wanted);
             else
               vtk.fail("attribute '" + words[0] +
                        "' (knee_contact reads SCALARS, VECTORS, NORMALS, "
@@ -450,6 +521,9 @@ namespace knee_contact
               n_points = vtk.count(words[1], "point count");
               if (n_points > std::size_t(-1) / 3)
                 vtk.fail("point count " + words[1] + " is too large");
+              // A plane mesh has about as many cells as points (at least
+              // half as many): the run's need, before anything is read.
+              check_run_fits(2, n_points / 2., vtk.where("POINTS " + words[1]));
               points      = vtk.values(3 * n_points, words[2], "POINTS");
               have_points = true;
               vtk.skip_metadata();
@@ -461,6 +535,7 @@ namespace knee_contact
                 vtk.fail("CELLS needs two counts");
               const std::size_t first  = vtk.count(words[1], "cell count");
               const std::size_t second = vtk.count(words[2], "cell list size");
+              check_run_fits(2, first, vtk.where("CELLS " + words[1]));
               if (vtk.next_is("OFFSETS"))
                 {
                   auto next = vtk.keyword_line("OFFSETS");
@@ -533,12 +608,7 @@ namespace knee_contact
           else if (kind == "FIELD")
             {
               // Data of the whole set (TIME, CYCLE): not mesh data.
-              read_field(vtk,
-                         words,
-                         std::size_t(-1),
-                         [](const std::string &,
-                            const unsigned int,
-                            std::vector<double> &&) {});
+              read_field(vtk, words, std::size_t(-1), nullptr, nullptr);
               words.clear();
             }
           else if (kind == "CELL_DATA" || kind == "POINT_DATA")

@@ -1,3 +1,4 @@
+#include <knee_contact/mesh/mesh.h>
 #include <knee_contact/mesh/readers/line_reader.h>
 
 #include <deal.II/grid/grid_tools.h>
@@ -29,11 +30,11 @@ namespace knee_contact
         VtuArrays(const std::string &file,
                   const bool         header_64,
                   const bool         compressed,
-                  std::string        appended)
+                  std::string_view   appended)
           : file(file)
           , header_64(header_64)
           , compressed(compressed)
-          , appended(std::move(appended))
+          , appended(appended)
         {}
 
         /**
@@ -158,7 +159,7 @@ namespace knee_contact
         }
 
         std::uint64_t
-        header_item(const std::string &bytes, const std::size_t i) const
+        header_item(const std::string_view bytes, const std::size_t i) const
         {
           const std::size_t size = header_64 ? 8 : 4;
           if (bytes.size() < (i + 1) * size)
@@ -218,10 +219,10 @@ namespace knee_contact
          * @p header_bytes: the length of a header padded by base64.
          */
         std::string
-        unpack(const std::string &bytes,
-               const std::string &name,
-               const std::size_t  expected,
-               std::size_t        header_bytes = 0) const
+        unpack(const std::string_view bytes,
+               const std::string     &name,
+               const std::size_t      expected,
+               std::size_t            header_bytes = 0) const
         {
           const std::size_t size = header_64 ? 8 : 4;
           if (!compressed)
@@ -230,7 +231,7 @@ namespace knee_contact
               if (n > bytes.size() - size)
                 fail("DataArray '" + name + "' says " + std::to_string(n) +
                      " bytes, holds " + std::to_string(bytes.size() - size));
-              return bytes.substr(size, n);
+              return std::string(bytes.substr(size, n));
             }
           const std::uint64_t n_blocks = header_item(bytes, 0),
                               block    = header_item(bytes, 1),
@@ -300,8 +301,85 @@ namespace knee_contact
         const std::string file;
         const bool        header_64;
         const bool        compressed;
-        const std::string appended;
+        /** The raw appended data, a view into the mapped file. */
+        const std::string_view appended;
       };
+
+      /**
+       * The deepest nesting of XML elements that a VTU file may have. A VTK
+       * UnstructuredGrid needs six levels (VTKFile, UnstructuredGrid, Piece,
+       * Cells, DataArray, and InformationKey in VTK 9's metadata); Boost's
+       * XML parser recurses once per level on the stack, so an unbounded
+       * depth is a crash (100 000 levels overflowed it).
+       */
+      constexpr unsigned int max_xml_depth = 64;
+
+      /**
+       * The line at which the nesting of @p text first exceeds
+       * max_xml_depth, or 0. A scan of the markup only: comments, CDATA,
+       * processing instructions and declarations are skipped, quoted
+       * attribute values may hold '>' and '/'. Written by hand because
+       * Boost's parser (the one that recurses) is the only XML parser here.
+       */
+      std::size_t
+      too_deep_at(const std::string &text)
+      {
+        unsigned int depth = 0;
+        std::size_t  line  = 1;
+        const auto   skip  = [&](std::size_t from, const char *end) {
+          const auto at = text.find(end, from);
+          if (at == std::string::npos)
+            return text.size();
+          line += std::count(text.begin() + from, text.begin() + at, '\n');
+          return at + std::strlen(end);
+        };
+        for (std::size_t i = 0; i < text.size();)
+          {
+            if (text[i] == '\n')
+              ++line;
+            if (text[i] != '<')
+              {
+                ++i;
+                continue;
+              }
+            if (text.compare(i, 4, "<!--") == 0)
+              i = skip(i, "-->");
+            else if (text.compare(i, 9, "<![CDATA[") == 0)
+              i = skip(i, "]]>");
+            else if (text.compare(i, 2, "<?") == 0)
+              i = skip(i, "?>");
+            else if (text.compare(i, 2, "<!") == 0)
+              i = skip(i, ">");
+            else if (text.compare(i, 2, "</") == 0)
+              {
+                if (depth > 0)
+                  --depth;
+                i = skip(i, ">");
+              }
+            else
+              {
+                // An opening tag: to its '>', outside quoted values.
+                char        quote = 0;
+                std::size_t j     = i + 1;
+                for (; j < text.size(); ++j)
+                  {
+                    if (text[j] == '\n')
+                      ++line;
+                    if (quote != 0)
+                      quote = text[j] == quote ? 0 : quote;
+                    else if (text[j] == '"' || text[j] == '\'')
+                      quote = text[j];
+                    else if (text[j] == '>')
+                      break;
+                  }
+                if (j < text.size() && text[j - 1] != '/' &&
+                    ++depth > max_xml_depth)
+                  return line;
+                i = j + 1;
+              }
+          }
+        return 0;
+      }
     } // namespace
 
 
@@ -309,35 +387,42 @@ namespace knee_contact
     Description<2>
     read_vtu(const std::string &file)
     {
-      const std::uintmax_t size = std::filesystem::file_size(file);
-      std::ifstream        in(file, std::ios::binary);
-      std::string          text(size, '\0');
-      in.read(text.data(), size);
-      AssertThrow(in.good() || in.eof(),
-                  ExcMessage("Mesh/File: cannot read '" + file + "'"));
-      const auto fail = [&file](const std::string &what) {
+      // Mapped, not read: the XML part is copied out below, the appended
+      // data are decoded where they lie.
+      const MappedFile       mapped(file);
+      const std::string_view whole = mapped.text();
+      const std::uintmax_t   size  = whole.size();
+      const auto             fail  = [&file](const std::string &what) {
         throw std::runtime_error(
           input::cap("Mesh/File: '" + file + "': " + what));
       };
 
       // Raw appended data is not XML: cut it off before parsing.
-      std::string appended;
-      const auto  appended_at = text.find("<AppendedData");
+      std::string_view appended;
+      std::string      text;
+      const auto       appended_at = whole.find("<AppendedData");
       if (appended_at != std::string::npos)
         {
-          const auto tag_end = text.find('>', appended_at);
-          const auto start   = text.find('_', tag_end);
-          const auto end     = text.rfind("</AppendedData>");
+          const auto tag_end = whole.find('>', appended_at);
+          const auto start   = whole.find('_', tag_end);
+          const auto end     = whole.rfind("</AppendedData>");
           if (tag_end == std::string::npos || start == std::string::npos ||
               end == std::string::npos || end < start)
             fail("the AppendedData section is cut off");
-          if (text.substr(appended_at, tag_end - appended_at).find("\"raw\"") ==
-              std::string::npos)
+          if (whole.substr(appended_at, tag_end - appended_at)
+                .find("\"raw\"") == std::string::npos)
             fail("appended data that is not raw (write it raw, or as "
                  "ascii or binary DataArrays)");
-          appended = text.substr(start + 1, end - start - 1);
-          text     = text.substr(0, appended_at) + "</VTKFile>";
+          appended = whole.substr(start + 1, end - start - 1);
+          text     = std::string(whole.substr(0, appended_at)) + "</VTKFile>";
         }
+      else
+        text = std::string(whole);
+      if (const auto line = too_deep_at(text))
+        fail("line " + std::to_string(line) + ": XML elements nested " +
+             "deeper than " + std::to_string(max_xml_depth) +
+             " levels (a VTU file needs 6; the limit bounds the XML " +
+             "parser's recursion)");
       boost::property_tree::ptree tree;
       try
         {
@@ -386,10 +471,17 @@ namespace knee_contact
       };
       const std::size_t n_points = count("NumberOfPoints"),
                         n_cells  = count("NumberOfCells");
+      // The run's need before anything is decoded: a plane mesh has about
+      // as many cells as points, at least half as many.
+      check_run_fits(2,
+                     std::max(double(n_cells), n_points / 2.),
+                     "Mesh/File: '" + file + "': NumberOfPoints " +
+                       std::to_string(n_points) + ", NumberOfCells " +
+                       std::to_string(n_cells));
       const VtuArrays arrays(file,
                              header == "UInt64",
                              !compressor.empty(),
-                             std::move(appended));
+                             appended);
       const auto      array = [&](const std::string &section,
                              const std::string &name,
                              const std::size_t  n,

@@ -4,6 +4,11 @@
 #include <knee_contact/core/input.h>
 #include <knee_contact/mesh/mesh_readers.h>
 
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -11,6 +16,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -25,6 +31,58 @@ namespace knee_contact
      */
     namespace internal
     {
+      /**
+       * A file mapped read-only into memory (mmap): the whole file is
+       * addressable without being read or allocated; pages are read when
+       * touched, so a huge or sparse file costs nothing until its content
+       * is used, and each size a reader takes from the file is checked
+       * before anything of that size is allocated. Written by hand because
+       * neither deal.II nor the C++ library maps files.
+       */
+      class MappedFile
+      {
+      public:
+        explicit MappedFile(const std::string &file)
+        {
+          const int fd = open(file.c_str(), O_RDONLY | O_CLOEXEC);
+          AssertThrow(fd >= 0,
+                      ExcMessage("Mesh/File: cannot open '" + file + "'"));
+          struct stat status;
+          if (fstat(fd, &status) == 0 && status.st_size > 0)
+            {
+              size = static_cast<std::size_t>(status.st_size);
+              data = mmap(nullptr, size, PROT_READ, MAP_PRIVATE, fd, 0);
+            }
+          close(fd);
+          AssertThrow(data != MAP_FAILED,
+                      ExcMessage("Mesh/File: cannot read '" + file + "'"));
+        }
+
+        ~MappedFile()
+        {
+          if (data != MAP_FAILED && data != nullptr)
+            munmap(data, size);
+        }
+
+        MappedFile(const MappedFile &) = delete;
+        MappedFile &
+        operator=(const MappedFile &) = delete;
+
+        std::string_view
+        text() const
+        {
+          return data == nullptr
+                   ? std::string_view()
+                   : std::string_view(static_cast<const char *>(data), size);
+        }
+
+      private:
+        void       *data = nullptr;
+        std::size_t size = 0;
+      };
+
+
+
       /**
        * A text file read line by line, with errors that name file and line.
        */
@@ -49,8 +107,24 @@ namespace knee_contact
               pending = false;
               return true;
             }
-          if (!std::getline(in, line))
+          // Read at most max_line_length characters: a file of one endless
+          // line (a sparse file of zeros) must not be read into memory.
+          if (buffer.empty())
+            buffer.resize(max_line_length + 1);
+          in.getline(buffer.data(), buffer.size());
+          const std::streamsize n = in.gcount();
+          if (in.bad() || (n == 0 && in.eof()))
             return false;
+          if (in.fail() && !in.eof())
+            {
+              ++number;
+              fail("a line longer than " +
+                   std::to_string(max_line_length / 1024) +
+                   " kB (no mesh format read by lines needs that; not a "
+                   "text mesh file?)");
+            }
+          // gcount() counts the '\n' it took, not at the end of the file.
+          line.assign(buffer.data(), in.eof() ? n : n - 1);
           ++number;
           if (!line.empty() && line.back() == '\r')
             line.pop_back();
@@ -76,11 +150,14 @@ namespace knee_contact
         const std::string file;
         std::uintmax_t    size   = 0;
         unsigned long     number = 0;
+        /** The longest line read (Abaqus allows 256 characters). */
+        static constexpr std::size_t max_line_length = 1 << 20;
 
       private:
-        std::ifstream in;
-        std::string   held;
-        bool          pending = false;
+        std::ifstream     in;
+        std::vector<char> buffer;
+        std::string       held;
+        bool              pending = false;
       };
 
       inline std::string
