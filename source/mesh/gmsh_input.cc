@@ -106,6 +106,15 @@ namespace knee_contact
           if (!in)
             throw std::runtime_error("Mesh/File: cannot open '" + name +
                                      "' (included by '" + file + "')");
+          // A script, read whole: bounded (generated .geo files with
+          // thousands of points take a few MB).
+          constexpr std::uintmax_t max_size = 64u << 20;
+          std::error_code          code;
+          if (std::filesystem::file_size(name, code) > max_size && !code)
+            throw std::runtime_error("Mesh/File: '" + name +
+                                     "' is larger than " +
+                                     std::to_string(max_size >> 20) +
+                                     " MB, the most a .geo script may be");
           std::stringstream buffer;
           buffer << in.rdbuf();
           std::string text = buffer.str();
@@ -214,10 +223,15 @@ namespace knee_contact
     bool
     is_binary_msh(const std::string &file)
     {
+      // The first two lines from the first bytes only: the file may be
+      // anything, of any size.
       std::ifstream in(file, std::ios::binary);
-      std::string   header, format;
-      std::getline(in, header);
-      std::getline(in, format);
+      char          start[256];
+      in.read(start, sizeof(start));
+      std::istringstream lines(std::string(start, in.gcount()));
+      std::string        header, format;
+      std::getline(lines, header);
+      std::getline(lines, format);
       std::istringstream words(format);
       std::string        version, file_type;
       words >> version >> file_type;

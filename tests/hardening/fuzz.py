@@ -120,15 +120,22 @@ def main():
 
 def run_cases(program, cases, what):
     """Run the cases (name, scene text with @WORK@ for the work folder[,
-    (file name, bytes) written into it]) two at a time; print the exit
+    (file name, bytes or (bytes, size of a sparse file)) written into
+    it]) two at a time; print the exit
     codes and the failures; 1 if any case failed, else 0."""
     def one(case):
         name, text = case[0], case[1]
         work = tempfile.mkdtemp(prefix="knee_fuzz_")
         try:
             if len(case) > 2:
+                content = case[2][1]
                 with open(os.path.join(work, case[2][0]), "wb") as f:
-                    f.write(case[2][1])
+                    # (bytes, size): a sparse file of size.
+                    if isinstance(content, tuple):
+                        f.write(content[0])
+                        f.truncate(content[1])
+                    else:
+                        f.write(content)
             return run(program, name, text.replace("@WORK@", work), work)
         finally:
             shutil.rmtree(work, ignore_errors=True)

@@ -7,7 +7,9 @@ flat and multi-part and Gmsh's .inp, the 3D two-part deck of abaqus_3d.py,
 .vtk in the ASCII and binary 4.2 layout and meshio's ASCII and binary 5.1
 layout, .ucd, .vtu in five encodings); each file is then damaged with a fixed
 seed: cut at several offsets, bytes overwritten by random bytes, a digit
-changed into a large or negative number, lines dropped or repeated. Every
+changed into a large or negative number, lines dropped or repeated,
+100 000 nested elements inserted, cut and extended by a hole to a sparse
+file of 4.3 GB. Every
 damaged file is run through the scene; as in fuzz.py, each run must end
 within a time limit with exit code 0-3, never a crash, an internal error, a
 sanitizer report or a hang, and a refusal (exit 1) must be one line
@@ -42,8 +44,18 @@ SETS = {".inp": ("BODY_1: 1; BODY_2: 2",
 
 
 def damage(data, rng):
-    """One damaged copy of data (bytes) and what was done."""
-    kind = rng.randrange(4)
+    """One damaged copy of data (bytes) and what was done; a copy to be
+    made sparse is (bytes, size): a hole after the bytes up to 4.3 GB."""
+    kind = rng.randrange(6)
+    if kind == 4:
+        # Elements (of XML; text in other formats) nested 100 000 deep.
+        at = rng.randrange(len(data))
+        return (data[:at] + b"<a>" * 100000 + b"</a>" * 100000 + data[at:],
+                "100 000 nested elements at %d" % at)
+    if kind == 5:
+        # The file cut and continued by a hole of zeros to 4.3 GB.
+        cut = rng.randrange(len(data))
+        return (data[:cut], 4300000000), "cut at %d, sparse to 4.3 GB" % cut
     if kind == 0:
         cut = rng.randrange(len(data))
         return data[:cut], "cut at byte %d" % cut

@@ -59,8 +59,13 @@ namespace knee_contact
         {
           if (at >= text.size())
             return false;
-          const auto end = std::min(text.find('\n', at), text.size());
-          line_number    = newlines + 1;
+          // Looked for within max_line_length only: the rest of a huge file
+          // is not touched.
+          const auto length = text.substr(at, max_line_length + 1).find('\n');
+          const auto end    = length == std::string::npos
+                                ? std::min(at + max_line_length + 1, text.size())
+                                : at + length;
+          line_number       = newlines + 1;
           if (end - at > max_line_length)
             fail("a line longer than " +
                  std::to_string(max_line_length / 1024) +

@@ -397,6 +397,50 @@ namespace knee_contact
           input::cap("Mesh/File: '" + file + "': " + what));
       };
 
+      // The sizes first, from the Piece tag near the start (before it only
+      // the header and FieldData): the run they ask for must fit, and the
+      // file may hold no more than such a mesh can take (4 kB per point
+      // and cell is generous: ASCII coordinates, connectivity and a few
+      // dozen data arrays), so that nothing of a huge file is touched.
+      {
+        constexpr std::size_t  head_length = 1 << 16;
+        const std::string_view head        = whole.substr(0, head_length);
+        const auto             piece_at    = head.find("<Piece");
+        if (piece_at == std::string::npos)
+          fail("no <Piece> in the first " + std::to_string(head_length >> 10) +
+               " kB (not a VTK UnstructuredGrid file?)");
+        const auto attribute = [&](const std::string &name) {
+          const auto tag_end = head.find('>', piece_at);
+          const auto at      = head.find(name + "=\"", piece_at);
+          if (tag_end == std::string::npos || at == std::string::npos ||
+              at > tag_end)
+            fail("the Piece tag has no " + name);
+          const auto  value = head.substr(at + name.size() + 2, 20);
+          std::size_t n = 0, digits = 0;
+          while (digits < value.size() &&
+                 std::isdigit(static_cast<unsigned char>(value[digits])) &&
+                 digits < 19)
+            n = 10 * n + (value[digits++] - '0');
+          if (digits == 0 || digits == value.size() || value[digits] != '"')
+            fail("Piece has no valid " + name);
+          return n;
+        };
+        const double n_points = attribute("NumberOfPoints"),
+                     n_cells  = attribute("NumberOfCells");
+        check_run_fits(2,
+                       std::max(n_cells, n_points / 2.),
+                       "Mesh/File: '" + file + "': NumberOfPoints " +
+                         std::to_string(std::size_t(n_points)) +
+                         ", NumberOfCells " +
+                         std::to_string(std::size_t(n_cells)));
+        const double most = 4096. * (n_points + n_cells) + (1 << 20);
+        if (size > most)
+          fail("the file's " + std::to_string(size) + " bytes are more than " +
+               std::to_string(std::size_t(n_points)) + " points and " +
+               std::to_string(std::size_t(n_cells)) + " cells take (at most " +
+               std::to_string(std::size_t(most)) + ": 4 kB each and 1 MB)");
+      }
+
       // Raw appended data is not XML: cut it off before parsing.
       std::string_view appended;
       std::string      text;
@@ -471,13 +515,6 @@ namespace knee_contact
       };
       const std::size_t n_points = count("NumberOfPoints"),
                         n_cells  = count("NumberOfCells");
-      // The run's need before anything is decoded: a plane mesh has about
-      // as many cells as points, at least half as many.
-      check_run_fits(2,
-                     std::max(double(n_cells), n_points / 2.),
-                     "Mesh/File: '" + file + "': NumberOfPoints " +
-                       std::to_string(n_points) + ", NumberOfCells " +
-                       std::to_string(n_cells));
       const VtuArrays arrays(file,
                              header == "UInt64",
                              !compressor.empty(),
