@@ -4,6 +4,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <spawn.h>
+#include <sys/resource.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -145,7 +146,8 @@ namespace knee_contact
   ProgramResult
   run_program(const std::vector<std::string> &arguments,
               const std::string              &log,
-              const double                    time_limit)
+              const double                    time_limit,
+              const double                    memory_limit)
   {
     ProgramResult result;
     if (arguments.empty())
@@ -162,12 +164,25 @@ namespace knee_contact
     posix_spawn_file_actions_destroy(&actions);
     if (pid <= 0)
       return result;
+    // posix_spawn returns once the program runs: it has allocated nothing
+    // of its work yet.
+    if (memory_limit > 0)
+      {
+        const rlimit limit{static_cast<rlim_t>(memory_limit),
+                           static_cast<rlim_t>(memory_limit)};
+        prlimit(pid, RLIMIT_AS, &limit, nullptr);
+      }
 
     const int wait_status = wait_at_most(pid, time_limit, result.timed_out);
 
     set_status(wait_status, result);
     std::ifstream in(log);
     result.message = message_of(in);
+    result.out_of_memory =
+      memory_limit > 0 && !result.timed_out && result.exit_code != 0 &&
+      (result.message.find("bad_alloc") != std::string::npos ||
+       result.message.find("out of memory") != std::string::npos ||
+       result.signal == SIGABRT || result.signal == SIGSEGV);
     return result;
   }
 
@@ -354,9 +369,16 @@ namespace knee_contact
                    const std::string   &program,
                    const std::string   &file,
                    const std::string   &time_limit_parameter,
-                   const double         time_limit)
+                   const double         time_limit,
+                   const std::string   &memory_limit_parameter,
+                   const double         memory_limit)
   {
     std::string line = program + " failed on '" + file + "': ";
+    if (result.out_of_memory)
+      return line + "it ran out of the " +
+             std::to_string(static_cast<long>(memory_limit / 1048576.)) +
+             " MB it may use (" + memory_limit_parameter +
+             "; a finer mesh than this machine can solve?)";
     if (result.timed_out)
       return line + "no result within " +
              std::to_string(static_cast<long>(time_limit)) + " s (" +

@@ -1,5 +1,6 @@
 #include <knee_contact/core/external_program.h>
 #include <knee_contact/core/input.h>
+#include <knee_contact/core/memory.h>
 #include <knee_contact/mesh/gmsh_input.h>
 
 #include <algorithm>
@@ -34,19 +35,36 @@ namespace knee_contact
       run_gmsh(const std::vector<std::string> &command,
                const std::string              &input,
                const std::string              &msh,
-               const double                    time_limit)
+               const Limits                   &limits)
       {
         const std::string log =
           std::filesystem::path(msh).replace_extension(".log").string();
-        const ProgramResult result = run_program(command, log, time_limit);
+        const double        memory = limits.memory_bytes();
+        const ProgramResult result =
+          run_program(command, log, limits.seconds, memory);
         if (result.exit_code != 0 || !std::ifstream(msh).good() ||
             result.message.find("rror") != std::string::npos)
-          throw std::runtime_error(
-            "Mesh/File: " +
-            describe_failure(
-              result, "gmsh", input, "Mesh/Gmsh time limit", time_limit));
+          throw std::runtime_error("Mesh/File: " +
+                                   describe_failure(result,
+                                                    "gmsh",
+                                                    input,
+                                                    "Mesh/Gmsh time limit",
+                                                    limits.seconds,
+                                                    "Mesh/Gmsh memory limit",
+                                                    memory));
       }
     } // namespace
+
+
+
+    double
+    Limits::memory_bytes() const
+    {
+      if (megabytes > 0)
+        return megabytes * 1048576.;
+      std::string which;
+      return memory::available(which) / 4;
+    }
 
 
 
@@ -204,7 +222,7 @@ namespace knee_contact
     mesh(const std::string              &geo,
          const std::string              &msh,
          const std::vector<std::string> &extra,
-         const double                    time_limit)
+         const Limits                   &limits)
     {
       check_geo(geo);
       // Format 4.1: its $Entities section lists every surface and volume, so
@@ -215,7 +233,7 @@ namespace knee_contact
         "gmsh", "-3", "-format", "msh41", "-v", "2", "-nopopup"};
       command.insert(command.end(), extra.begin(), extra.end());
       command.insert(command.end(), {"-o", msh, geo});
-      run_gmsh(command, geo, msh, time_limit);
+      run_gmsh(command, geo, msh, limits);
     }
 
 
@@ -244,7 +262,7 @@ namespace knee_contact
     void
     convert(const std::string &binary_msh,
             const std::string &msh,
-            const double       time_limit)
+            const Limits      &limits)
     {
       // -0: read the file and write it out again, no meshing.
       run_gmsh({"gmsh",
@@ -259,7 +277,7 @@ namespace knee_contact
                 binary_msh},
                binary_msh,
                msh,
-               time_limit);
+               limits);
     }
   } // namespace gmsh_input
 } // namespace knee_contact

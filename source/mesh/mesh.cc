@@ -94,6 +94,14 @@ namespace knee_contact
                       "Seconds gmsh may take to mesh a .geo before it is "
                       "stopped and the run refused [s].",
                       Patterns::Double(1));
+    prm.add_parameter(
+      "Gmsh memory limit",
+      gmsh_memory_limit,
+      "Memory gmsh may take (its address space) to mesh a .geo before it "
+      "fails and the run is refused [MB]; 0: a quarter of the memory "
+      "available to the run (the least of MemAvailable, the cgroup's limit "
+      "and ulimit -v), which leaves the rest to the solve of the mesh.",
+      Patterns::Double(0));
     // x0, y0, x1, y1 [m], n_x, n_y, material id, group, and the boundary ids
     // of the left, right, bottom and top sides.
     const Patterns::Integer id(0, 254), count(1, 99999);

@@ -62,7 +62,7 @@ namespace knee_contact
     std::unique_ptr<CheckedMsh>
     checked_msh(const std::string              &file,
                 const std::vector<std::string> &arguments,
-                const double                    time_limit)
+                const gmsh_input::Limits       &limits)
     {
       if (kept_msh && kept_msh->file == file &&
           kept_msh->arguments == arguments)
@@ -83,9 +83,9 @@ namespace knee_contact
           result->folder = folder;
           result->msh    = folder + "/mesh.msh";
           if (geo)
-            gmsh_input::mesh(file, result->msh, arguments, time_limit);
+            gmsh_input::mesh(file, result->msh, arguments, limits);
           else
-            gmsh_input::convert(file, result->msh, time_limit);
+            gmsh_input::convert(file, result->msh, limits);
         }
       // deal.II's reader trusts its input; check the file first.
       try
@@ -117,8 +117,9 @@ namespace knee_contact
       input::resolve_path(mesh_input.entries.file, scene_file);
     const auto arguments =
       gmsh_input::arguments(mesh_input.entries.gmsh_arguments);
-    const double time_limit = mesh_input.gmsh_time_limit;
-    const auto   extension  = std::filesystem::path(file).extension();
+    const gmsh_input::Limits limits{mesh_input.gmsh_time_limit,
+                                    mesh_input.gmsh_memory_limit};
+    const auto extension = std::filesystem::path(file).extension();
     // Anything else is 2D; a missing file is reported by MeshInput.
     if (!from_file ||
         (extension != ".msh" && extension != ".geo" && extension != ".inp") ||
@@ -126,7 +127,7 @@ namespace knee_contact
       return 2;
     if (extension == ".inp")
       return mesh_readers::abaqus_dimension(file);
-    kept_msh = checked_msh(file, arguments, time_limit);
+    kept_msh = checked_msh(file, arguments, limits);
     return kept_msh->dim;
   }
 
@@ -174,7 +175,10 @@ namespace knee_contact
         else
           arguments.insert(arguments.end(), {"-clscale", scale.str()});
       }
-    auto msh = checked_msh(file, arguments, gmsh_time_limit);
+    auto msh =
+      checked_msh(file,
+                  arguments,
+                  gmsh_input::Limits{gmsh_time_limit, gmsh_memory_limit});
     AssertThrow(msh->dim == dim, ExcInternalError());
     // An entity in several physical groups: the one the scene names.
     std::istringstream one_group(gmsh_input::one_group_per_entity(

@@ -21,6 +21,12 @@ namespace knee_contact
     int signal = 0;
     /** The first line of its output that holds "rror", else the last. */
     std::string message;
+    /**
+     * Ended by an allocation that failed under its memory limit
+     * (std::bad_alloc, "out of memory", or killed by SIGABRT or SIGSEGV
+     * while limited).
+     */
+    bool out_of_memory = false;
   };
 
   /**
@@ -29,12 +35,16 @@ namespace knee_contact
    * can be read as a command. Standard output and error go to @p log; the
    * program runs in its own process group, is killed (with its children)
    * after @p time_limit seconds, and is killed as well if the run is
-   * interrupted (see interruption.h).
+   * interrupted (see interruption.h). A @p memory_limit above 0 [bytes]
+   * bounds its address space (prlimit RLIMIT_AS, set as it starts): an
+   * allocation beyond fails in the program instead of growing until the
+   * machine swaps or the kernel kills something.
    */
   ProgramResult
   run_program(const std::vector<std::string> &arguments,
               const std::string              &log,
-              const double                    time_limit);
+              const double                    time_limit,
+              const double                    memory_limit = 0);
 
   /**
    * A helper program that lives as long as a run and serves requests: the
@@ -91,6 +101,7 @@ namespace knee_contact
   /**
    * One line for a failed run of @p program on @p file: "gmsh failed on
    * 'x.geo': ...", "... did not finish within 300 s (Mesh/Gmsh time
+   * limit)", "... ran out of the 6000 MB it may use (Mesh/Gmsh memory
    * limit)", "... could not be started".
    */
   std::string
@@ -98,7 +109,9 @@ namespace knee_contact
                    const std::string   &program,
                    const std::string   &file,
                    const std::string   &time_limit_parameter,
-                   const double         time_limit);
+                   const double         time_limit,
+                   const std::string   &memory_limit_parameter = "",
+                   const double         memory_limit           = 0);
 } // namespace knee_contact
 
 #endif

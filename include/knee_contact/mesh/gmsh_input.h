@@ -35,6 +35,22 @@ namespace knee_contact
     check_geo(const std::string &file);
 
     /**
+     * What gmsh may take: Mesh/Gmsh time limit [s] and Mesh/Gmsh memory
+     * limit [MB]; 0 MB is a quarter of the memory available to the run
+     * (memory::available()), so that gmsh cannot starve the solve of the
+     * mesh it makes (a solve takes 8 to 35 kB a cell, gmsh far less).
+     */
+    struct Limits
+    {
+      double seconds   = 300;
+      double megabytes = 0;
+
+      /** The address-space limit for gmsh [bytes]. */
+      double
+      memory_bytes() const;
+    };
+
+    /**
      * Mesh @p geo with gmsh (argument vector, no shell, time limit) into
      * @p msh (format 2.2); errors name gmsh and the file.
      */
@@ -42,7 +58,7 @@ namespace knee_contact
     mesh(const std::string              &geo,
          const std::string              &msh,
          const std::vector<std::string> &arguments,
-         const double                    time_limit);
+         const Limits                   &limits);
 
     /** Whether @p file starts as a binary .msh (file-type 1). */
     bool
@@ -57,7 +73,7 @@ namespace knee_contact
     void
     convert(const std::string &binary_msh,
             const std::string &msh,
-            const double       time_limit);
+            const Limits      &limits);
 
     /**
      * Check the structure of an ASCII .msh file (version 2.2 or 4.1)

@@ -198,7 +198,8 @@ namespace knee_contact
     Source                                   source = Source::rectangles;
     std::string                              file;
     std::vector<std::string>                 gmsh_arguments;
-    double                                   gmsh_time_limit = 300;
+    double                                   gmsh_time_limit   = 300;
+    double                                   gmsh_memory_limit = 0;
     std::vector<Rectangle>                   rectangles;
     double                                   rotation_degrees = 0;
     unsigned int                             n_refinements    = 0;
