@@ -1,5 +1,6 @@
 #include <knee_contact/core/input.h>
 #include <knee_contact/core/interruption.h>
+#include <knee_contact/core/memory.h>
 #include <knee_contact/core/problem.h>
 #include <knee_contact/core/progress.h>
 
@@ -10,112 +11,158 @@
 #include <iostream>
 #include <new>
 #include <stdexcept>
+#include <system_error>
 
 // knee_contact: unilateral contact between linear elastic bodies in 2D, and
 // linear elasticity in 3D (the dimension comes from the mesh).
 // Usage: knee_contact [--dry-run] scene.prm | --help | --print-parameters
+namespace
+{
+  // One line, then leave without the library destructors: with the address
+  // space exhausted, OpenBLAS's worker threads retry their buffer
+  // allocation forever and its exit handler joins them, so a normal return
+  // hangs (measured: 10 minutes at 100 % CPU after the message). Everything
+  // of this run that lives on disk was already cleaned up during the
+  // unwinding that brought the exception here.
+  [[noreturn]] void
+  out_of_memory()
+  {
+    std::cerr << "knee_contact: error: out of memory (the mesh or the "
+                 "factorisation needs more than this machine has; use "
+                 "fewer refinements or a coarser mesh)"
+              << std::endl;
+    std::cout.flush();
+    std::_Exit(knee_contact::ExitCode::input_error);
+  }
+
+  int
+  run(int argc, char **argv);
+} // namespace
+
 int
 main(int argc, char **argv)
 {
-  using namespace knee_contact;
-  const std::string usage =
-    "usage: knee_contact SCENE.prm       solve the scene, results in its "
-    "output folder\n"
-    "       knee_contact --dry-run SCENE.prm  read the scene and build its "
-    "mesh, no solve\n"
-    "       knee_contact --print-parameters   every parameter with its "
-    "documentation and default\n"
-    "       knee_contact --help\n";
-  interruption::install();
-  Progress::start_clock();
-  try
+  const int code = run(argc, argv);
+  // Under an address-space limit an OpenBLAS worker may be stuck retrying
+  // its buffer (see memory::prepare_blas()), and exit() would join it:
+  // leave without the exit handlers (the results are on disk, the streams
+  // flushed).
+  if (knee_contact::memory::address_space_limited())
     {
-      if (argc == 2 && (std::strcmp(argv[1], "--help") == 0 ||
-                        std::strcmp(argv[1], "-h") == 0))
-        {
-          std::cout << usage;
-          return ExitCode::success;
-        }
-      if (argc == 2 && std::strcmp(argv[1], "--print-parameters") == 0)
-        {
-          // The 2D scene format; in 3D the vectors have a z component.
-          ContactProblem<2>::print_parameters(std::cout);
-          return ExitCode::success;
-        }
-      if (argc == 3 && std::strcmp(argv[1], "--dry-run") == 0)
-        {
-          if (scene_dimension(argv[2]) == 3)
-            ContactProblem<3>(argv[2]).check_scene();
-          else
-            ContactProblem<2>(argv[2]).check_scene();
-          return ExitCode::success;
-        }
-      if (argc != 2 || argv[1][0] == '-')
-        {
-          std::cerr << "knee_contact: error: expected one scene file; see "
-                       "knee_contact --help"
-                    << std::endl;
-          return ExitCode::input_error;
-        }
-      if (scene_dimension(argv[1]) == 3)
-        return ContactProblem<3>(argv[1]).run();
-      return ContactProblem<2>(argv[1]).run();
-    }
-  // A message built for the user (ExcMessage from AssertThrow, or a
-  // runtime_error of the input checks) is bad input; out of memory is said
-  // as such; anything else is a bug of the program.
-  catch (const dealii::StandardExceptions::ExcMessage &exc)
-    {
-      std::ostringstream info;
-      exc.print_info(info);
-      std::cerr << "knee_contact: error: " << input::one_line(info.str())
-                << std::endl;
-      return ExitCode::input_error;
-    }
-  catch (const std::bad_alloc &)
-    {
-      std::cerr << "knee_contact: error: out of memory (the mesh or the "
-                   "factorisation needs more than this machine has; use "
-                   "fewer refinements or a coarser mesh)"
-                << std::endl;
-      // Leave without the library destructors: with the address space
-      // exhausted, OpenBLAS's worker threads retry their buffer allocation
-      // forever and its exit handler joins them, so a normal return hangs
-      // (measured: 10 minutes at 100 % CPU after the message). Everything
-      // of this run that lives on disk was already cleaned up during the
-      // unwinding that brought the exception here.
       std::cout.flush();
-      std::_Exit(ExitCode::input_error);
+      std::cerr.flush();
+      std::_Exit(code);
     }
-  catch (const dealii::ExceptionBase &exc)
-    {
-      std::ostringstream info;
-      exc.print_info(info);
-      std::cerr << "knee_contact: internal error (a bug; please report it "
-                   "with the scene file): "
-                << input::one_line(exc.get_exc_name() + std::string(": ") +
-                                   info.str())
-                << std::endl;
-      return ExitCode::internal_error;
-    }
-  catch (const std::runtime_error &exc)
-    {
-      std::cerr << "knee_contact: error: " << input::one_line(exc.what())
-                << std::endl;
-      return ExitCode::input_error;
-    }
-  catch (const std::exception &exc)
-    {
-      std::cerr << "knee_contact: internal error (a bug; please report it "
-                   "with the scene file): "
-                << input::one_line(exc.what()) << std::endl;
-      return ExitCode::internal_error;
-    }
-  catch (...)
-    {
-      std::cerr << "knee_contact: internal error (a bug; please report it "
-                   "with the scene file): unknown exception"
-                << std::endl;
-      return ExitCode::internal_error;
-    }
+  return code;
 }
+
+namespace
+{
+  int
+  run(int argc, char **argv)
+  {
+    using namespace knee_contact;
+    const std::string usage =
+      "usage: knee_contact SCENE.prm       solve the scene, results in its "
+      "output folder\n"
+      "       knee_contact --dry-run SCENE.prm  read the scene and build its "
+      "mesh, no solve\n"
+      "       knee_contact --print-parameters   every parameter with its "
+      "documentation and default\n"
+      "       knee_contact --help\n";
+    interruption::install();
+    Progress::start_clock();
+    try
+      {
+        memory::prepare_blas();
+        if (argc == 2 && (std::strcmp(argv[1], "--help") == 0 ||
+                          std::strcmp(argv[1], "-h") == 0))
+          {
+            std::cout << usage;
+            return ExitCode::success;
+          }
+        if (argc == 2 && std::strcmp(argv[1], "--print-parameters") == 0)
+          {
+            // The 2D scene format; in 3D the vectors have a z component.
+            ContactProblem<2>::print_parameters(std::cout);
+            return ExitCode::success;
+          }
+        if (argc == 3 && std::strcmp(argv[1], "--dry-run") == 0)
+          {
+            if (scene_dimension(argv[2]) == 3)
+              ContactProblem<3>(argv[2]).check_scene();
+            else
+              ContactProblem<2>(argv[2]).check_scene();
+            return ExitCode::success;
+          }
+        if (argc != 2 || argv[1][0] == '-')
+          {
+            std::cerr << "knee_contact: error: expected one scene file; see "
+                         "knee_contact --help"
+                      << std::endl;
+            return ExitCode::input_error;
+          }
+        if (scene_dimension(argv[1]) == 3)
+          return ContactProblem<3>(argv[1]).run();
+        return ContactProblem<2>(argv[1]).run();
+      }
+    // A message built for the user (ExcMessage from AssertThrow, or a
+    // runtime_error of the input checks) is bad input; out of memory is said
+    // as such; anything else is a bug of the program.
+    catch (const dealii::StandardExceptions::ExcMessage &exc)
+      {
+        std::ostringstream info;
+        exc.print_info(info);
+        std::cerr << "knee_contact: error: " << input::one_line(info.str())
+                  << std::endl;
+        return ExitCode::input_error;
+      }
+    catch (const std::bad_alloc &)
+      {
+        out_of_memory();
+      }
+    catch (const std::system_error &exc)
+      {
+        // A thread that could not be started (EAGAIN or ENOMEM: its stack
+        // could not be mapped) is out of memory too; it said "Resource
+        // temporarily unavailable".
+        if (exc.code() == std::errc::resource_unavailable_try_again ||
+            exc.code() == std::errc::not_enough_memory)
+          out_of_memory();
+        std::cerr << "knee_contact: error: " << input::one_line(exc.what())
+                  << std::endl;
+        return ExitCode::input_error;
+      }
+    catch (const dealii::ExceptionBase &exc)
+      {
+        std::ostringstream info;
+        exc.print_info(info);
+        std::cerr << "knee_contact: internal error (a bug; please report it "
+                     "with the scene file): "
+                  << input::one_line(exc.get_exc_name() + std::string(": ") +
+                                     info.str())
+                  << std::endl;
+        return ExitCode::internal_error;
+      }
+    catch (const std::runtime_error &exc)
+      {
+        std::cerr << "knee_contact: error: " << input::one_line(exc.what())
+                  << std::endl;
+        return ExitCode::input_error;
+      }
+    catch (const std::exception &exc)
+      {
+        std::cerr << "knee_contact: internal error (a bug; please report it "
+                     "with the scene file): "
+                  << input::one_line(exc.what()) << std::endl;
+        return ExitCode::internal_error;
+      }
+    catch (...)
+      {
+        std::cerr << "knee_contact: internal error (a bug; please report it "
+                     "with the scene file): unknown exception"
+                  << std::endl;
+        return ExitCode::internal_error;
+      }
+  }
+} // namespace

@@ -1,5 +1,6 @@
 #include <knee_contact/core/memory.h>
 
+#include <dlfcn.h>
 #include <sys/resource.h>
 
 #include <algorithm>
@@ -7,7 +8,9 @@
 #include <iomanip>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
 #include <utility>
+#include <vector>
 
 namespace knee_contact
 {
@@ -54,7 +57,7 @@ namespace knee_contact
 
 
     double
-    available(std::string &which)
+    available(std::string &which, const bool address_space)
     {
       double available = std::numeric_limits<double>::max();
       which            = "no limit found";
@@ -76,10 +79,10 @@ namespace knee_contact
           if (max >= 0 && max < 1e18 && used >= 0)
             take(std::max(0., max - used), "the cgroup's memory limit");
         }
-      rlimit address_space;
-      if (getrlimit(RLIMIT_AS, &address_space) == 0 &&
-          address_space.rlim_cur != RLIM_INFINITY)
-        take(std::max(0., double(address_space.rlim_cur) - process_virtual()),
+      rlimit limit;
+      if (address_space && getrlimit(RLIMIT_AS, &limit) == 0 &&
+          limit.rlim_cur != RLIM_INFINITY)
+        take(std::max(0., double(limit.rlim_cur) - process_virtual()),
              "the address-space limit (ulimit -v)");
       return available;
     }
@@ -90,6 +93,68 @@ namespace knee_contact
     process_virtual()
     {
       return read_field("/proc/self/status", "VmSize:", 1024.);
+    }
+
+
+
+    bool
+    address_space_limited()
+    {
+      rlimit address_space;
+      return getrlimit(RLIMIT_AS, &address_space) == 0 &&
+             address_space.rlim_cur != RLIM_INFINITY;
+    }
+
+
+
+    void
+    prepare_blas()
+    {
+      if (!address_space_limited())
+        return;
+      std::string  which;
+      const double room = available(which);
+      if (room < 2 * 128 * 1048576.)
+        throw std::runtime_error(
+          "out of memory: " + which + " leaves " + megabytes(room) +
+          "; the linear algebra (OpenBLAS) alone needs 256 MB");
+      using set_threads = void (*)(int);
+      if (const auto set = reinterpret_cast<set_threads>(
+            dlsym(RTLD_DEFAULT, "openblas_set_num_threads")))
+        set(1);
+      using gemm = void (*)(const char *,
+                            const char *,
+                            const int *,
+                            const int *,
+                            const int *,
+                            const double *,
+                            const double *,
+                            const int *,
+                            const double *,
+                            const int *,
+                            const double *,
+                            double *,
+                            const int *);
+      if (const auto product =
+            reinterpret_cast<gemm>(dlsym(RTLD_DEFAULT, "dgemm_")))
+        {
+          const int           n   = 128;
+          const double        one = 1, zero = 0;
+          std::vector<double> a(n * n, 1.), c(n * n);
+          product("N",
+                  "N",
+                  &n,
+                  &n,
+                  &n,
+                  &one,
+                  a.data(),
+                  &n,
+                  a.data(),
+                  &n,
+                  &zero,
+                  c.data(),
+                  &n);
+        }
     }
 
 

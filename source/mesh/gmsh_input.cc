@@ -3,6 +3,8 @@
 #include <knee_contact/core/memory.h>
 #include <knee_contact/mesh/gmsh_input.h>
 
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -62,8 +64,18 @@ namespace knee_contact
     {
       if (megabytes > 0)
         return megabytes * 1048576.;
+      // gmsh is a process of its own: the memory of the machine counts,
+      // not this process's address space; at least the 256 MB it needs to
+      // start and mesh small scenes (200 MB measured), at most the
+      // address-space limit it would inherit.
       std::string which;
-      return memory::available(which) / 4;
+      double      bytes =
+        std::max(memory::available(which, false) / 4, 256 * 1048576.);
+      rlimit inherited;
+      if (getrlimit(RLIMIT_AS, &inherited) == 0 &&
+          inherited.rlim_cur != RLIM_INFINITY)
+        bytes = std::min(bytes, double(inherited.rlim_cur));
+      return bytes;
     }
 
 

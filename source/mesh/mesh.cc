@@ -99,8 +99,9 @@ namespace knee_contact
       gmsh_memory_limit,
       "Memory gmsh may take (its address space) to mesh a .geo before it "
       "fails and the run is refused [MB]; 0: a quarter of the memory "
-      "available to the run (the least of MemAvailable, the cgroup's limit "
-      "and ulimit -v), which leaves the rest to the solve of the mesh.",
+      "available on the machine (the lesser of MemAvailable and the cgroup's "
+      "limit; at least 256 MB), which leaves the rest to the solve of the "
+      "mesh.",
       Patterns::Double(0));
     // x0, y0, x1, y1 [m], n_x, n_y, material id, group, and the boundary ids
     // of the left, right, bottom and top sides.
@@ -310,8 +311,9 @@ namespace knee_contact
     check_run_fits(dim,
                    triangulation.n_active_cells() *
                      std::pow(double(1u << dim), n_refine),
-                   "Mesh/Global refinements: " + std::to_string(n_refine) +
-                     " refinements");
+                   n_refine > 0 ? "Mesh/Global refinements: " +
+                                    std::to_string(n_refine) + " refinements"
+                                : std::string("Mesh: the scene's mesh"));
     triangulation.refine_global(n_refine);
     if (n_refine > 0)
       check_cells(triangulation);

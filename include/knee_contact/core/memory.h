@@ -16,10 +16,11 @@ namespace knee_contact
      * Bytes this process can still allocate before the kernel refuses or
      * kills it: the least of MemAvailable, the cgroup's limit (v2 or v1)
      * less its usage, and the address-space limit (ulimit -v) less the
-     * process's mapped size. @p which names the binding limit.
+     * process's mapped size (unless not @p address_space: for another
+     * process). @p which names the binding limit.
      */
     double
-    available(std::string &which);
+    available(std::string &which, bool address_space = true);
 
     /** The process's mapped size (VmSize) [bytes], or -1. */
     double
@@ -28,6 +29,26 @@ namespace knee_contact
     /** "123 MB". */
     std::string
     megabytes(double bytes);
+
+    /** Whether an address-space limit (ulimit -v) is in force. */
+    bool
+    address_space_limited();
+
+    /**
+     * Make OpenBLAS safe under an address-space limit, at the start of
+     * main(): OpenBLAS retries a failed allocation of its buffer (128 MB a
+     * thread) forever (blas_memory_alloc), in a worker thread from its
+     * start and in the calling thread at its first level-3 call; the
+     * factorisation then waits for a worker that never comes, and exit()
+     * joins it (measured: 7 hangs in 11 runs of a 300 x 300 block at
+     * 1.2 GB). Under a limit: OpenBLAS on one thread (the workers are
+     * never asked), the calling thread's buffer taken now, while there is
+     * room (a 128 x 128 product), and a refusal if the limit leaves less
+     * than two buffers. Without a limit nothing changes. The symbols are
+     * looked up at run time: another BLAS has none of this.
+     */
+    void
+    prepare_blas();
   } // namespace memory
 } // namespace knee_contact
 

@@ -36,9 +36,10 @@ namespace knee_contact
 
     /**
      * What gmsh may take: Mesh/Gmsh time limit [s] and Mesh/Gmsh memory
-     * limit [MB]; 0 MB is a quarter of the memory available to the run
-     * (memory::available()), so that gmsh cannot starve the solve of the
-     * mesh it makes (a solve takes 8 to 35 kB a cell, gmsh far less).
+     * limit [MB]; 0 MB is a quarter of the machine's memory available
+     * (MemAvailable, the cgroup's limit; at least 256 MB), so that gmsh
+     * cannot starve the solve of the mesh it makes (a solve takes 8 to 35
+     * kB a cell, gmsh far less).
      */
     struct Limits
     {
