@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
+#include <iomanip>
 #include <iostream>
 #include <sstream>
 
@@ -205,6 +206,16 @@ namespace knee_contact
                   ExcMessage("parameter '" + parameter + "': '" + expression +
                              "' is not finite"));
       return value;
+    }
+
+
+
+    std::string
+    format(const double value)
+    {
+      std::ostringstream out;
+      out << std::setprecision(6) << value;
+      return out.str();
     }
 
 

@@ -1,6 +1,7 @@
 // The cycles of a run: mesh, setup, assembly, contact solve and errors per
 // refinement cycle (ContactProblem's orchestration, split from problem.cc
 // by job as ASPECT splits its Simulator).
+#include <knee_contact/core/input.h>
 #include <knee_contact/core/problem.h>
 #include <knee_contact/core/progress.h>
 #include <knee_contact/mesh/scene_checks.h>
@@ -208,7 +209,7 @@ namespace knee_contact
             if (cycle + 1 == n_cycles)
               output_writer.warn(
                 "Refinement/Target error " +
-                std::to_string(refinement.target_error) + " for '" +
+                input::format(refinement.target_error) + " for '" +
                 refinement.target_quantity + "' not reached in " +
                 std::to_string(n_cycles) +
                 " cycles; raise the number of cycles or the target");

@@ -115,7 +115,8 @@ namespace knee_contact
         // Syntax errors are ParameterHandler's to report, with its message.
         try
           {
-            (void)nlohmann::json::parse(in, callback);
+            [[maybe_unused]] const auto outline =
+              nlohmann::json::parse(in, callback);
           }
         catch (const nlohmann::json::exception &)
           {}

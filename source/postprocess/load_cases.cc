@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iomanip>
+#include <sstream>
 
 namespace knee_contact
 {
@@ -55,7 +56,17 @@ namespace knee_contact
             const double step  = input::to_double(range[1], parameter);
             const double last  = input::to_double(range[2], parameter);
             const double n     = (last - first) / step;
-            AssertThrow(step > 0 && last >= first && n < max_cases &&
+            if (step > 0 && last >= first && !(n < max_cases))
+              {
+                std::ostringstream count;
+                count << std::setprecision(3) << n + 1;
+                AssertThrow(false,
+                            ExcMessage("parameter '" + parameter +
+                                       "': range '" + entry + "' gives " +
+                                       count.str() + " load cases; at most " +
+                                       std::to_string(max_cases)));
+              }
+            AssertThrow(step > 0 && last >= first &&
                           std::abs(n - std::round(n)) <= 1e-9 * (1 + n),
                         ExcMessage("parameter '" + parameter + "': range '" +
                                    entry +

@@ -135,6 +135,14 @@ namespace knee_contact
     one_line(const std::string &text);
 
     /**
+     * @p value in a message: six significant digits, exponent where it
+     * needs one ("1e-300", "0.002", "2.5e+09"); std::to_string prints
+     * fixed six decimals (1e-300 as "0.000000").
+     */
+    std::string
+    format(double value);
+
+    /**
      * Shorten values echoed in a message ('...' or <...>) to 200 bytes and
      * the whole message to 1000: a 6 MB expression is not a message.
      */
