@@ -3,6 +3,7 @@
 #include <knee_contact/core/input.h>
 #include <knee_contact/mesh/gmsh_input.h>
 #include <knee_contact/mesh/mesh.h>
+#include <knee_contact/mesh/readers/line_reader.h>
 
 #include <algorithm>
 #include <cctype>
@@ -60,20 +61,16 @@ namespace knee_contact
         bool
         next(std::vector<std::string> &tokens)
         {
-          // At most max_line_length characters: a file of one endless line
-          // (a sparse file of zeros) is not read into memory.
           std::string line;
-          buffer.resize(max_line_length + 1);
-          in.getline(buffer.data(), buffer.size());
-          const std::streamsize n = in.gcount();
-          if (in.bad() || (n == 0 && in.eof()))
+          const auto read = mesh_readers::internal::read_line(in, buffer, line);
+          if (read == mesh_readers::internal::LineRead::end)
             return false;
           ++line_number;
-          if (in.fail() && !in.eof())
-            fail("a line longer than " +
-                 std::to_string(max_line_length / 1024) +
-                 " kB (not a .msh file?)");
-          line.assign(buffer.data(), in.eof() ? n : n - 1);
+          if (read == mesh_readers::internal::LineRead::too_long)
+            fail(
+              "a line longer than " +
+              std::to_string(mesh_readers::internal::max_line_length / 1024) +
+              " kB (not a .msh file?)");
           tokens.clear();
           std::istringstream words(line);
           for (std::string w; words >> w;)
@@ -191,12 +188,10 @@ namespace knee_contact
         const std::string file;
 
       private:
-        // The longest line read.
-        static constexpr std::size_t max_line_length = 1 << 20;
-        std::ifstream                in;
-        std::vector<char>            buffer;
-        unsigned long long           size        = 0;
-        unsigned long                line_number = 0;
+        std::ifstream      in;
+        std::vector<char>  buffer;
+        unsigned long long size        = 0;
+        unsigned long      line_number = 0;
       };
 
 

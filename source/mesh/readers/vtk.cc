@@ -40,9 +40,7 @@ namespace knee_contact
         [[noreturn]] void
         fail(const std::string &what) const
         {
-          throw std::runtime_error(
-            input::cap("Mesh/File: '" + file + "' line " +
-                       std::to_string(line_number) + ": " + what));
+          throw std::runtime_error(input::cap(where(what)));
         }
 
         /** "Mesh/File: 'f.vtk' line 12: @p what". */
@@ -270,9 +268,8 @@ namespace knee_contact
 
       public:
         bool binary = false;
-        /** The longest keyword line and ASCII value read. */
-        static constexpr std::size_t max_line_length = 1 << 20,
-                                     max_word_length = 256;
+        /** The longest ASCII value read. */
+        static constexpr std::size_t max_word_length = 256;
         /** The line of what was read last, for messages. */
         unsigned long line_number = 0;
 

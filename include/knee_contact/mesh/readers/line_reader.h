@@ -31,6 +31,38 @@ namespace knee_contact
      */
     namespace internal
     {
+      /** The longest line a text mesh file may have (Abaqus allows 256). */
+      constexpr std::size_t max_line_length = 1 << 20;
+
+      enum class LineRead
+      {
+        line,
+        end,
+        too_long
+      };
+
+      /**
+       * The next line of @p in into @p line (without its '\n'), reading at
+       * most max_line_length characters through @p buffer: a file of one
+       * endless line (a sparse file of zeros) is never read into memory.
+       */
+      inline LineRead
+      read_line(std::istream &in, std::vector<char> &buffer, std::string &line)
+      {
+        buffer.resize(max_line_length + 1);
+        in.getline(buffer.data(), buffer.size());
+        const std::streamsize n = in.gcount();
+        if (in.bad() || (n == 0 && in.eof()))
+          return LineRead::end;
+        if (in.fail() && !in.eof())
+          return LineRead::too_long;
+        // gcount() counts the '\n' it took, not at the end of the file.
+        line.assign(buffer.data(), in.eof() ? n : n - 1);
+        return LineRead::line;
+      }
+
+
+
       /**
        * A file mapped read-only into memory (mmap): the whole file is
        * addressable without being read or allocated; pages are read when
@@ -107,15 +139,10 @@ namespace knee_contact
               pending = false;
               return true;
             }
-          // Read at most max_line_length characters: a file of one endless
-          // line (a sparse file of zeros) must not be read into memory.
-          if (buffer.empty())
-            buffer.resize(max_line_length + 1);
-          in.getline(buffer.data(), buffer.size());
-          const std::streamsize n = in.gcount();
-          if (in.bad() || (n == 0 && in.eof()))
+          const LineRead read = read_line(in, buffer, line);
+          if (read == LineRead::end)
             return false;
-          if (in.fail() && !in.eof())
+          if (read == LineRead::too_long)
             {
               ++number;
               fail("a line longer than " +
@@ -123,8 +150,6 @@ namespace knee_contact
                    " kB (no mesh format read by lines needs that; not a "
                    "text mesh file?)");
             }
-          // gcount() counts the '\n' it took, not at the end of the file.
-          line.assign(buffer.data(), in.eof() ? n : n - 1);
           ++number;
           if (!line.empty() && line.back() == '\r')
             line.pop_back();
@@ -150,8 +175,6 @@ namespace knee_contact
         const std::string file;
         std::uintmax_t    size   = 0;
         unsigned long     number = 0;
-        /** The longest line read (Abaqus allows 256 characters). */
-        static constexpr std::size_t max_line_length = 1 << 20;
 
       private:
         std::ifstream     in;
