@@ -4,6 +4,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <iomanip>
 #include <limits>
@@ -79,10 +80,8 @@ namespace knee_contact
           if (max >= 0 && max < 1e18 && used >= 0)
             take(std::max(0., max - used), "the cgroup's memory limit");
         }
-      rlimit limit;
-      if (address_space && getrlimit(RLIMIT_AS, &limit) == 0 &&
-          limit.rlim_cur != RLIM_INFINITY)
-        take(std::max(0., double(limit.rlim_cur) - process_virtual()),
+      if (address_space && address_space_limited())
+        take(std::max(0., address_space_limit() - process_virtual()),
              "the address-space limit (ulimit -v)");
       return available;
     }
@@ -97,12 +96,22 @@ namespace knee_contact
 
 
 
-    bool
-    address_space_limited()
+    double
+    address_space_limit()
     {
       rlimit address_space;
       return getrlimit(RLIMIT_AS, &address_space) == 0 &&
-             address_space.rlim_cur != RLIM_INFINITY;
+                 address_space.rlim_cur != RLIM_INFINITY
+               ? double(address_space.rlim_cur)
+               : std::numeric_limits<double>::infinity();
+    }
+
+
+
+    bool
+    address_space_limited()
+    {
+      return std::isfinite(address_space_limit());
     }
 
 

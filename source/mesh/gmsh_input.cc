@@ -3,8 +3,6 @@
 #include <knee_contact/core/memory.h>
 #include <knee_contact/mesh/gmsh_input.h>
 
-#include <sys/resource.h>
-
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -69,13 +67,9 @@ namespace knee_contact
       // start and mesh small scenes (200 MB measured), at most the
       // address-space limit it would inherit.
       std::string which;
-      double      bytes =
-        std::max(memory::available(which, false) / 4, 256 * 1048576.);
-      rlimit inherited;
-      if (getrlimit(RLIMIT_AS, &inherited) == 0 &&
-          inherited.rlim_cur != RLIM_INFINITY)
-        bytes = std::min(bytes, double(inherited.rlim_cur));
-      return bytes;
+      return std::min(std::max(memory::available(which, false) / 4,
+                               256 * 1048576.),
+                      memory::address_space_limit());
     }
 
 

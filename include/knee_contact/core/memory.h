@@ -30,6 +30,10 @@ namespace knee_contact
     std::string
     megabytes(double bytes);
 
+    /** The address-space limit (ulimit -v) [bytes], or infinity. */
+    double
+    address_space_limit();
+
     /** Whether an address-space limit (ulimit -v) is in force. */
     bool
     address_space_limited();

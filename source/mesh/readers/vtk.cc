@@ -385,11 +385,12 @@ namespace knee_contact
               vtk.fail("FIELD array '" + array[0] + "' has " + array[1] +
                        " components");
             // Arrays nobody keeps are read past, not stored.
-            auto values = vtk.values(n_components * n_tuples,
+            const bool kept   = keep != nullptr && wanted(array[0]);
+            auto       values = vtk.values(n_components * n_tuples,
                                      array[3],
                                      "FIELD array " + array[0],
-                                     keep != nullptr && wanted(array[0]));
-            if (keep != nullptr && wanted(array[0]))
+                                     kept);
+            if (kept)
               keep(array[0],
                    static_cast<unsigned int>(n_components),
                    std::move(values));
