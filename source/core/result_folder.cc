@@ -45,11 +45,20 @@ namespace knee_contact
 
   ResultFolder::ResultFolder(const std::string &folder_name)
   {
-    fs::path path = fs::path(folder_name).lexically_normal();
-    if (!path.has_filename() && path.has_parent_path())
-      path = path.parent_path();
-    if (path.filename().empty() || path.filename() == "." ||
-        path.filename() == "..")
+    // @p p normalised, without a trailing '/'; whether it names a folder
+    // of its own (not '.', '..' or '/').
+    const auto normal = [](const fs::path &p) {
+      fs::path result = p.lexically_normal();
+      if (!result.has_filename() && result.has_parent_path())
+        result = result.parent_path();
+      return result;
+    };
+    const auto own_name = [](const fs::path &p) {
+      return !p.filename().empty() && p.filename() != "." &&
+             p.filename() != "..";
+    };
+    fs::path path = normal(folder_name);
+    if (!own_name(path))
       throw error("'" + folder_name +
                   "' must name a folder of its own (not '.', '..' or '/')");
     // A symbolic link (results -> /data/run7) stays a link: the result set
@@ -66,12 +75,9 @@ namespace knee_contact
         if (code)
           throw error("cannot read the link '" + path.string() +
                       "': " + code.message());
-        path = (target.is_absolute() ? target : path.parent_path() / target)
-                 .lexically_normal();
-        if (!path.has_filename() && path.has_parent_path())
-          path = path.parent_path();
-        if (path.filename().empty() || path.filename() == "." ||
-            path.filename() == "..")
+        path =
+          normal(target.is_absolute() ? target : path.parent_path() / target);
+        if (!own_name(path))
           throw error("'" + folder_name + "' links to '" + path.string() +
                       "', which does not name a folder of its own");
       }
