@@ -167,6 +167,19 @@ namespace knee_contact
 
 
 
+  void
+  ContactInterfaces::check_dimension(const unsigned int dim) const
+  {
+    for (unsigned int i = 0; i < list.size(); ++i)
+      AssertThrow(dim == 2 || list[i].friction == Friction::none,
+                  ExcMessage("Contact/Interface " + std::to_string(i) +
+                             "/Friction: the mesh is 3D and friction is 2D "
+                             "only so far (3D contact is frictionless); set "
+                             "it to none"));
+  }
+
+
+
   template <int dim>
   void
   ContactInterfaces::check_mesh(const Triangulation<dim>        &triangulation,
@@ -207,15 +220,29 @@ namespace knee_contact
 
   namespace
   {
-    // Outward normal of a boundary face of a cell, with the face's length
-    // as its norm (so that summing over a vertex's faces weights by length).
-    Tensor<1, 2>
-    outward_normal(const DoFHandler<2>::active_cell_iterator &cell,
-                   const unsigned int                         f)
+    // Outward normal of a boundary face of a cell, with the face's measure
+    // (length in 2D, area in 3D) as its norm, so that summing over a
+    // vertex's faces weights by measure. 3D: the cross product of the
+    // diagonals (a quadrilateral's 0-3 and 1-2), which is the normal at
+    // the centre of a bilinear face with the area of a flat one.
+    template <int dim>
+    Tensor<1, dim>
+    outward_normal(const typename DoFHandler<dim>::active_cell_iterator &cell,
+                   const unsigned int                                    f)
     {
-      const auto   face = cell->face(f);
-      Tensor<1, 2> t    = face->vertex(1) - face->vertex(0);
-      Tensor<1, 2> n({t[1], -t[0]});
+      const auto     face = cell->face(f);
+      Tensor<1, dim> n;
+      if constexpr (dim == 2)
+        {
+          const Tensor<1, 2> t = face->vertex(1) - face->vertex(0);
+          n                    = Tensor<1, 2>({t[1], -t[0]});
+        }
+      else if (face->n_vertices() == 3)
+        n = 0.5 * cross_product_3d(face->vertex(1) - face->vertex(0),
+                                   face->vertex(2) - face->vertex(0));
+      else
+        n = 0.5 * cross_product_3d(face->vertex(3) - face->vertex(0),
+                                   face->vertex(2) - face->vertex(1));
       if (n * (face->center() - cell->center()) < 0)
         n = -n;
       return n;
@@ -247,41 +274,61 @@ namespace knee_contact
       pair.reduced_gap = rhs;
     }
 
-    ContactSides
-    collect_sides(const DoFHandler<2>    &dof_handler,
+    // Faces that are neither segments, triangles nor quadrilaterals cannot
+    // occur in deal.II's meshes; 3D faces carry 3 or 4 vertices.
+    template <int dim>
+    ContactSides<dim>
+    collect_sides(const DoFHandler<dim>  &dof_handler,
                   const ContactInterface &interface)
     {
-      ContactSides sides;
+      using Face = typename ContactSides<dim>::Face;
+      ContactSides<dim> sides;
       sides.min_length = std::numeric_limits<double>::max();
       for (const auto &cell : dof_handler.active_cell_iterators())
         for (const unsigned int f : cell->face_indices())
-          if (cell->face(f)->at_boundary())
+          if (cell->face(f)->at_boundary() &&
+              (cell->face(f)->boundary_id() == interface.slave_id ||
+               cell->face(f)->boundary_id() == interface.master_id))
             {
-              const auto         face = cell->face(f);
-              const Tensor<1, 2> n    = outward_normal(cell, f);
-              ContactSides::Face side;
-              for (unsigned int v = 0; v < 2; ++v)
+              const auto           face = cell->face(f);
+              const Tensor<1, dim> n    = outward_normal<dim>(cell, f);
+              Face                 side;
+              side.n_vertices = face->n_vertices();
+              AssertThrow(side.n_vertices <= Face::max_vertices,
+                          ExcInternalError());
+              for (unsigned int v = 0; v < side.n_vertices; ++v)
                 {
                   side.vertex_keys[v] = face->vertex_index(v);
                   side.vertices[v]    = face->vertex(v);
-                  side.dofs[v]        = {{face->vertex_dof_index(v, 0),
-                                          face->vertex_dof_index(v, 1)}};
+                  for (unsigned int d = 0; d < dim; ++d)
+                    side.dofs[v][d] = face->vertex_dof_index(v, d);
                 }
-              side.normal = n / n.norm();
+              side.normal  = n / n.norm();
+              side.measure = n.norm();
+              for (unsigned int v = 0; v < side.n_vertices; ++v)
+                for (unsigned int w = v + 1; w < side.n_vertices; ++w)
+                  side.diameter =
+                    std::max(side.diameter,
+                             side.vertices[v].distance(side.vertices[w]));
               if (face->boundary_id() == interface.slave_id)
                 {
-                  for (unsigned int v = 0; v < 2; ++v)
+                  for (unsigned int v = 0; v < side.n_vertices; ++v)
                     {
                       auto &s    = sides.slaves[side.vertex_keys[v]];
                       s.position = side.vertices[v];
-                      s.normal += n; // length-weighted: |n| = face length
-                      s.length += 0.5 * n.norm();
+                      s.normal += n; // measure-weighted: |n| = measure
+                      if constexpr (dim == 2)
+                        s.length += 0.5 * n.norm();
+                      else
+                        s.length += n.norm() / side.n_vertices;
                       s.dofs = side.dofs[v];
                     }
-                  sides.min_length = std::min(sides.min_length, n.norm());
+                  sides.min_length =
+                    std::min(sides.min_length,
+                             dim == 2 ? n.norm() : side.diameter);
                   sides.slave_faces.push_back(side);
                 }
-              else if (face->boundary_id() == interface.master_id)
+              else
                 sides.master_faces.push_back(side);
             }
       return sides;
@@ -290,117 +337,13 @@ namespace knee_contact
 
 
 
-  /**
-   * Node-to-segment: x + s n = p0 + xi (p1 - p0), the closest master face
-   * facing the slave (n_master . n < 0) along the slave normal n.
-   */
-  struct MasterHit
-  {
-    const ContactSides::Face *face = nullptr;
-    double                    s    = std::numeric_limits<double>::max();
-    double                    xi   = 0;
-  };
-
-  MasterHit
-  master_along_normal(const ContactSides &sides,
-                      const Point<2>     &position,
-                      const Tensor<1, 2> &n,
-                      const double        length)
-  {
-    MasterHit hit;
-    for (const ContactSides::Face &m : sides.master_faces)
-      {
-        if (m.normal * n >= 0)
-          continue;
-        const Tensor<1, 2> t   = m.vertices[1] - m.vertices[0];
-        const Tensor<1, 2> r   = m.vertices[0] - position;
-        const double       det = -n[0] * t[1] + n[1] * t[0];
-        if (std::abs(det) < 1e-12 * t.norm())
-          continue;
-        const double s  = (-r[0] * t[1] + r[1] * t[0]) / det;
-        const double xi = (n[0] * r[1] - n[1] * r[0]) / det;
-        if (xi < -1e-10 || xi > 1 + 1e-10 || s < -2 * length)
-          continue;
-        if (std::abs(s) < std::abs(hit.s))
-          {
-            hit.s    = s;
-            hit.xi   = std::clamp(xi, 0., 1.);
-            hit.face = &m;
-          }
-      }
-    return hit;
-  }
-
-
-
-  ContactPairs<2>
-  node_to_segment_rows(const ContactSides     &sides,
-                       const ContactInterface &interface,
-                       const unsigned int      interface_index,
-                       const std::string      &where)
-  {
-    ContactPairs<2> pairs;
-    for (const auto &[vertex, slave] : sides.slaves)
-      {
-        const Tensor<1, 2> n   = slave.unit_normal();
-        const double       tol = 1e-8 * sides.min_length;
-        const MasterHit    hit =
-          master_along_normal(sides, slave.position, n, slave.length);
-        double                    best_s  = hit.s;
-        double                    best_xi = hit.xi;
-        const ContactSides::Face *best    = hit.face;
-        if (best != nullptr && std::abs(best_s) <= tol)
-          best_s = 0;
-        if (best != nullptr && (best_xi < 1e-8 || best_xi > 1 - 1e-8) &&
-            best_s == 0)
-          best_xi = std::round(best_xi);
-        if (interface.pairing == Pairing::node_to_node)
-          AssertThrow(best != nullptr && best_s == 0 &&
-                        (best_xi == 0 || best_xi == 1),
-                      ExcMessage(where +
-                                 "node-to-node pairing: slave "
-                                 "vertex at (" +
-                                 std::to_string(slave.position[0]) + ", " +
-                                 std::to_string(slave.position[1]) +
-                                 ") has no coincident master vertex"));
-        if (best == nullptr ||
-            (interface.maximum_gap > 0 && best_s > interface.maximum_gap))
-          continue;
-        AssertThrow(best_s >= -tol,
-                    ExcMessage(where + "slave vertex at (" +
-                               std::to_string(slave.position[0]) + ", " +
-                               std::to_string(slave.position[1]) +
-                               ") penetrates the master side by " +
-                               std::to_string(-best_s) +
-                               " m; initial overlap is not supported"));
-
-        ContactRow pair;
-        pair.interface = interface_index;
-        pair.gap       = best_s;
-        pair.length    = slave.length;
-        for (unsigned int d = 0; d < 2; ++d)
-          pair.row.emplace_back(slave.dofs[d], n[d]);
-        for (unsigned int v = 0; v < 2; ++v)
-          {
-            const double weight = v == 0 ? 1 - best_xi : best_xi;
-            if (weight != 0)
-              for (unsigned int d = 0; d < 2; ++d)
-                pair.row.emplace_back(best->dofs[v][d], -weight * n[d]);
-          }
-        pairs.push_back(std::move(pair), {slave.position, n, slave.dofs, {}});
-      }
-    return pairs;
-  }
-
-
-
-  template <>
-  ContactPairs<2>
-  ContactInterfaces::make_pairs<2>(
-    const DoFHandler<2>             &dof_handler,
+  template <int dim>
+  ContactPairs<dim>
+  ContactInterfaces::make_pairs(
+    const DoFHandler<dim>           &dof_handler,
     const AffineConstraints<double> &constraints) const
   {
-    ContactPairs<2>                   pairs;
+    ContactPairs<dim>                 pairs;
     std::set<types::global_dof_index> eliminated;
     const bool                        friction =
       std::any_of(list.begin(), list.end(), [](const ContactInterface &i) {
@@ -410,15 +353,16 @@ namespace knee_contact
     for (unsigned int i = 0; i < list.size(); ++i)
       {
         const ContactInterface &interface = list[i];
-        const ContactSides      sides = collect_sides(dof_handler, interface);
+        const ContactSides<dim> sides =
+          collect_sides<dim>(dof_handler, interface);
         const std::string where = "Contact/Interface " + std::to_string(i) +
                                   " ('" + interface.name + "'): ";
         AssertThrow(!sides.slaves.empty() && !sides.master_faces.empty(),
                     ExcMessage(where + "a side has no faces"));
-        ContactPairs<2> rows =
+        ContactPairs<dim> rows =
           interface.pairing == Pairing::mortar
-            ? mortar_rows(sides, interface, i, where)
-            : node_to_segment_rows(sides, interface, i, where);
+            ? mortar_rows<dim>(sides, interface, i, where)
+            : node_to_segment_rows<dim>(sides, interface, i, where);
 
         for (unsigned int p = 0; p < rows.size(); ++p)
           {
@@ -428,30 +372,29 @@ namespace knee_contact
             // entries w n_x, w n_y in turn; w t in their place, t the
             // tangent of the common normal n - n_master where the slave
             // normal meets the master (of n alone where it meets none).
-            Tensor<1, 2> &t = rows.points[p].tangent;
-            {
-              const Tensor<1, 2> &n   = rows.points[p].normal;
-              const MasterHit     hit = master_along_normal(sides,
-                                                        rows.points[p].position,
-                                                        n,
-                                                        pair.length);
-              Tensor<1, 2>        m   = n;
-              if (hit.face != nullptr)
-                m -= hit.face->normal;
-              m /= m.norm();
-              t[0] = -m[1];
-              t[1] = m[0];
-            }
-            ContactRow slide;
-            slide.interface = pair.interface;
-            slide.length    = pair.length;
-            for (std::size_t k = 0; k + 1 < pair.row.size(); k += 2)
+            Tensor<1, dim> &t = rows.points[p].tangent;
+            ContactRow      slide;
+            if constexpr (dim == 2)
               {
-                const Tensor<1, 2> &n = rows.points[p].normal;
-                const double        w =
-                  pair.row[k].second * n[0] + pair.row[k + 1].second * n[1];
-                slide.row.emplace_back(pair.row[k].first, w * t[0]);
-                slide.row.emplace_back(pair.row[k + 1].first, w * t[1]);
+                const Tensor<1, 2> &n   = rows.points[p].normal;
+                const MasterHit<2>  hit = master_along_normal(
+                  sides, rows.points[p].position, n, pair.length);
+                Tensor<1, 2> m = n;
+                if (hit.face != nullptr)
+                  m -= hit.face->normal;
+                m /= m.norm();
+                t[0]            = -m[1];
+                t[1]            = m[0];
+                slide.interface = pair.interface;
+                slide.length    = pair.length;
+                for (std::size_t k = 0; k + 1 < pair.row.size(); k += 2)
+                  {
+                    const Tensor<1, 2> &n = rows.points[p].normal;
+                    const double        w =
+                      pair.row[k].second * n[0] + pair.row[k + 1].second * n[1];
+                    slide.row.emplace_back(pair.row[k].first, w * t[0]);
+                    slide.row.emplace_back(pair.row[k + 1].first, w * t[1]);
+                  }
               }
             // Eliminate the free slave component with the largest
             // coefficient, else the largest free other component.
@@ -463,7 +406,8 @@ namespace knee_contact
                   for (const auto &[dof, a] : row.reduced_row)
                     {
                       const bool on_slave =
-                        dof == slave_dofs[0] || dof == slave_dofs[1];
+                        std::find(slave_dofs.begin(), slave_dofs.end(), dof) !=
+                        slave_dofs.end();
                       if (on_slave == slave_side && !eliminated.count(dof) &&
                           std::abs(a) > largest + 1e-12)
                         {
@@ -484,26 +428,27 @@ namespace knee_contact
             // u_x and u_y of the slave (the slave parts of N and T are n
             // and t): stick_coefficients().
             ContactRow x_row, y_row;
-            if (friction)
-              {
-                const Tensor<1, 2> &n = rows.points[p].normal;
-                const auto combine    = [&](const double a, const double b) {
-                  ContactRow combined;
-                  combined.interface = pair.interface;
-                  combined.length    = pair.length;
-                  combined.gap       = a * pair.gap + b * slide.gap;
-                  for (std::size_t k = 0; k < pair.row.size(); ++k)
-                    combined.row.emplace_back(pair.row[k].first,
-                                              a * pair.row[k].second +
-                                                b * slide.row[k].second);
-                  return combined;
-                };
-                const auto c = stick_coefficients(n, t);
-                x_row        = combine(c[0][0], c[0][1]);
-                y_row        = combine(c[1][0], c[1][1]);
-              }
+            if constexpr (dim == 2)
+              if (friction)
+                {
+                  const Tensor<1, 2> &n = rows.points[p].normal;
+                  const auto combine    = [&](const double a, const double b) {
+                    ContactRow combined;
+                    combined.interface = pair.interface;
+                    combined.length    = pair.length;
+                    combined.gap       = a * pair.gap + b * slide.gap;
+                    for (std::size_t k = 0; k < pair.row.size(); ++k)
+                      combined.row.emplace_back(pair.row[k].first,
+                                                a * pair.row[k].second +
+                                                  b * slide.row[k].second);
+                    return combined;
+                  };
+                  const auto c = stick_coefficients(n, t);
+                  x_row        = combine(c[0][0], c[0][1]);
+                  y_row        = combine(c[1][0], c[1][1]);
+                }
             choose(pair);
-            if (friction)
+            if (dim == 2 && friction)
               {
                 choose(slide);
                 slide.measured_only = true;
@@ -536,21 +481,12 @@ namespace knee_contact
 
 
 
-  template <>
-  ContactPairs<3>
-  ContactInterfaces::make_pairs<3>(const DoFHandler<3> &,
-                                   const AffineConstraints<double> &) const
-  {
-    AssertThrow(list.empty(),
-                ExcMessage("Contact: the mesh is 3D and 3D contact is not "
-                           "implemented yet (3D elasticity is; set Number "
-                           "of interfaces = 0 and hold the bodies by "
-                           "boundary conditions)"));
-    return {};
-  }
-
-
-
+  template ContactPairs<2>
+  ContactInterfaces::make_pairs(const DoFHandler<2> &,
+                                const AffineConstraints<double> &) const;
+  template ContactPairs<3>
+  ContactInterfaces::make_pairs(const DoFHandler<3> &,
+                                const AffineConstraints<double> &) const;
   template void
   ContactInterfaces::check_mesh(const Triangulation<2> &,
                                 const std::vector<unsigned int> &) const;

@@ -73,8 +73,9 @@ namespace knee_contact
 
 
 
+  template <>
   ContactPairs<2>
-  mortar_rows(const ContactSides     &sides,
+  mortar_rows(const ContactSides<2>  &sides,
               const ContactInterface &interface,
               const unsigned int      interface_index,
               const std::string      &where)
@@ -83,7 +84,7 @@ namespace knee_contact
     const double                        g   = 1 / std::sqrt(3.);
     const double                        tol = 1e-8 * sides.min_length;
 
-    for (const ContactSides::Face &slave : sides.slave_faces)
+    for (const ContactSides<2>::Face &slave : sides.slave_faces)
       {
         const Point<2>    &xa = slave.vertices[0];
         const Tensor<1, 2> e  = slave.vertices[1] - xa;
@@ -97,8 +98,8 @@ namespace knee_contact
         // parameter interval their projection covers, nearest first.
         struct Candidate
         {
-          double                    lo, hi, xi_c, xi_d, distance;
-          const ContactSides::Face *master;
+          double                       lo, hi, xi_c, xi_d, distance;
+          const ContactSides<2>::Face *master;
 
           // The point of the master face that projects onto slave
           // parameter xi.
@@ -111,7 +112,7 @@ namespace knee_contact
           }
         };
         std::vector<Candidate> candidates;
-        for (const ContactSides::Face &master : sides.master_faces)
+        for (const ContactSides<2>::Face &master : sides.master_faces)
           {
             if (master.normal * slave.normal >= 0)
               continue;
@@ -197,8 +198,8 @@ namespace knee_contact
     ContactPairs<2> pairs;
     for (const auto &[key, row] : rows)
       {
-        const ContactSides::SlaveVertex &vertex = sides.slaves.at(key);
-        const double                     weight = row.weight;
+        const ContactSides<2>::SlaveVertex &vertex = sides.slaves.at(key);
+        const double                        weight = row.weight;
         // A vertex whose faces the master covers for less than a quarter of
         // its weight (at an interface end that overhangs the master) gets
         // no row: int psi_j over a small end piece can be tiny or negative.

@@ -245,11 +245,7 @@ namespace knee_contact
       boundary_ids.insert({interface.slave_id, interface.master_id});
     mesh_input.set_scene_ids(materials.ids(), boundary_ids);
     scene_checks::check_roles(boundary_conditions, contact_interfaces);
-    AssertThrow(dim == 2 || contact_interfaces.interfaces().empty(),
-                ExcMessage("Contact/Number of interfaces: the mesh is 3D and "
-                           "3D contact is not implemented yet (3D elasticity "
-                           "is); set it to 0 and hold every body by boundary "
-                           "conditions"));
+    contact_interfaces.check_dimension(dim);
   }
 
 

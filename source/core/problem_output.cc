@@ -312,11 +312,13 @@ namespace knee_contact
             << bar(materials[id].name + ": von Mises max") << "\n";
     for (const auto &i : results.interfaces)
       out << "  contact '" << i.name << "': " << i.n_active << " of "
-          << i.n_pairs << " pairs active, force [N/m] " << i.force
+          << i.n_pairs << " pairs active, force "
+          << (dim == 2 ? "[N/m] " : "[N] ") << i.force
           << bar("interface " + i.name + ": force") << ", peak pressure [Pa] "
           << i.max_pressure << bar("interface " + i.name + ": peak pressure")
-          << ", contact length [m] " << i.contact_length
-          << bar("interface " + i.name + ": contact length") << "\n";
+          << (dim == 2 ? ", contact length [m] " : ", contact area [m^2] ")
+          << i.contact_length << bar("interface " + i.name + ": contact length")
+          << "\n";
     // What the bars rest on, once.
     if (!output_writer.test_mode() && !error_estimates.empty())
       {

@@ -357,7 +357,14 @@ namespace knee_contact
           {"max_pressure_error",
            error("interface " + i.name + ": peak pressure")},
           {"contact_length_error",
-           error("interface " + i.name + ": contact length")}};
+           error("interface " + i.name + ": contact length")},
+          {"peak_location", vector(i.peak_location)},
+          {"centre_of_pressure", vector(i.centre_of_pressure)},
+          {"mean_pressure", i.mean_pressure}};
+        // In 3D the slave boundary's share in contact is an area.
+        if (dim == 3)
+          summary["contact_interfaces"][i.name]["contact_area"] =
+            i.contact_length;
         if (!contact.lambda_t.empty())
           {
             auto &entry = summary["contact_interfaces"][i.name];

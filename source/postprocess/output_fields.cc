@@ -305,25 +305,38 @@ namespace knee_contact
     for (unsigned int i = 0; i < interfaces.interfaces().size(); ++i)
       {
         // Order the pairs along the interface by the coordinate it spans
-        // most, and measure arc length between slave vertices.
-        // (2D: 3D has no contact rows yet.)
+        // most (3D: then by the second), and in 2D measure arc length
+        // between slave vertices.
         std::vector<unsigned int> order;
-        Point<2>                  lower(1e300, 1e300), upper(-1e300, -1e300);
+        Point<dim>                lower, upper;
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            lower[d] = 1e300;
+            upper[d] = -1e300;
+          }
         for (unsigned int p = 0; p < pairs.size(); ++p)
           if (pairs.rows[p].interface == i)
             {
               order.push_back(p);
-              for (unsigned int d = 0; d < 2; ++d)
+              for (unsigned int d = 0; d < dim; ++d)
                 {
                   lower[d] = std::min(lower[d], pairs.points[p].position[d]);
                   upper[d] = std::max(upper[d], pairs.points[p].position[d]);
                 }
             }
-        const unsigned int axis =
-          (upper[0] - lower[0] >= upper[1] - lower[1]) ? 0 : 1;
+        std::vector<unsigned int> axes(dim);
+        for (unsigned int d = 0; d < dim; ++d)
+          axes[d] = d;
+        // The widest span first (ties: the lower axis, as before in 2D).
+        std::stable_sort(axes.begin(), axes.end(), [&](unsigned a, unsigned b) {
+          return upper[a] - lower[a] > upper[b] - lower[b];
+        });
         std::sort(order.begin(), order.end(), [&](unsigned a, unsigned b) {
-          return pairs.points[a].position[axis] <
-                 pairs.points[b].position[axis];
+          const Point<dim> &x = pairs.points[a].position;
+          const Point<dim> &y = pairs.points[b].position;
+          if (dim == 2 || x[axes[0]] != y[axes[0]])
+            return x[axes[0]] < y[axes[0]];
+          return x[axes[1]] < y[axes[1]];
         });
         const std::string name = csv_file_name(interfaces.interfaces()[i].name);
         write_file(name, [&](std::ostream &out) {
@@ -337,7 +350,8 @@ namespace knee_contact
           // and the status.
           const bool friction = contact.status.size() == pairs.size() &&
                                 contact.accumulated_slip.size() == pairs.size();
-          out << "arc_length,x,y,n_x,n_y,gap,jump,pressure,active,"
+          out << (dim == 2 ? "arc_length,x,y,n_x,n_y," : "x,y,z,n_x,n_y,n_z,")
+              << "gap,jump,pressure,active,"
               << (friction ? "t_x,t_y,tangential_traction,slip,"
                              "accumulated_slip,status,"
                            : "")
@@ -351,9 +365,13 @@ namespace knee_contact
               if (k > 0)
                 s +=
                   point.position.distance(pairs.points[order[k - 1]].position);
-              out << s << ',' << point.position[0] << ',' << point.position[1]
-                  << ',' << point.normal[0] << ',' << point.normal[1] << ','
-                  << row.gap << ',' << row.jump(solution) << ','
+              if (dim == 2)
+                out << s << ',';
+              for (unsigned int d = 0; d < dim; ++d)
+                out << point.position[d] << ',';
+              for (unsigned int d = 0; d < dim; ++d)
+                out << point.normal[d] << ',';
+              out << row.gap << ',' << row.jump(solution) << ','
                   << results.pressure[order[k]] << ','
                   << (contact.active[order[k]] ? 1 : 0) << ',';
               if (friction)

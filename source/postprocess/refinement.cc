@@ -1,3 +1,4 @@
+#include <knee_contact/contact/search.h>
 #include <knee_contact/core/input.h>
 #include <knee_contact/physics/elements.h>
 #include <knee_contact/postprocess/refinement.h>
@@ -147,24 +148,22 @@ namespace knee_contact
               if (cell->vertex(v).distance(centre) <= radius)
                 cell->set_refine_flag();
       }
-    if constexpr (dim == 2)
-      mark_partners(triangulation, interfaces);
-    else
-      Assert(interfaces.interfaces().empty(), ExcNotImplemented());
+    mark_partners(triangulation, interfaces);
     triangulation.execute_coarsening_and_refinement();
   }
 
 
 
+  template <int dim>
   void
-  Refinement::mark_partners(Triangulation<2>        &triangulation,
+  Refinement::mark_partners(Triangulation<dim>      &triangulation,
                             const ContactInterfaces &interfaces) const
   {
     struct Side
     {
-      Triangulation<2>::active_cell_iterator cell;
-      Point<2>                               centre;
-      double                                 length;
+      typename Triangulation<dim>::active_cell_iterator cell;
+      Point<dim>                                        centre;
+      double                                            length;
     };
     for (const auto &interface : interfaces.interfaces())
       {
@@ -175,38 +174,31 @@ namespace knee_contact
               for (unsigned int k = 0; k < 2; ++k)
                 if (face->boundary_id() ==
                     (k == 0 ? interface.slave_id : interface.master_id))
-                  sides[k].push_back({cell, face->center(), face->measure()});
-        // Facing faces: centres closer than half the sum of their lengths.
-        // Found once through a grid as fine as the longest face (so only
-        // neighbouring grid cells can hold a partner), then swept until no
-        // flag changes: a marked face of length h becomes h/2, and a facing
-        // face longer than 0.75 h is marked too.
+                  sides[k].push_back(
+                    {cell,
+                     face->center(),
+                     std::pow(face->measure(), 1. / (dim - 1))});
+        // Facing faces: centres closer than half the sum of their sizes
+        // (length in 2D, square root of the area in 3D). Found once through
+        // the contact search on the master centres, then swept until no
+        // flag changes: a marked face of size h becomes h/2, and a facing
+        // face larger than 0.75 h is marked too.
         double h = 0;
         for (const auto &side : sides)
           for (const Side &face : side)
             h = std::max(h, face.length);
-        std::map<std::pair<long, long>, std::vector<unsigned int>> grid;
-        const auto key = [h](const Point<2> &p) {
-          return std::make_pair(std::lround(std::floor(p[0] / h)),
-                                std::lround(std::floor(p[1] / h)));
-        };
-        for (unsigned int j = 0; j < sides[1].size(); ++j)
-          grid[key(sides[1][j].centre)].push_back(j);
+        std::vector<BoundingBox<dim>> centres;
+        for (const Side &face : sides[1])
+          centres.emplace_back(std::vector<Point<dim>>{face.centre});
+        const ContactSearch<dim>                           search(centres);
         std::vector<std::pair<unsigned int, unsigned int>> facing;
         for (unsigned int i = 0; i < sides[0].size(); ++i)
-          {
-            const auto [x, y] = key(sides[0][i].centre);
-            for (long dx = -1; dx <= 1; ++dx)
-              for (long dy = -1; dy <= 1; ++dy)
-                {
-                  const auto it = grid.find({x + dx, y + dy});
-                  if (it != grid.end())
-                    for (const unsigned int j : it->second)
-                      if (sides[0][i].centre.distance(sides[1][j].centre) <
-                          0.5 * (sides[0][i].length + sides[1][j].length))
-                        facing.emplace_back(i, j);
-                }
-          }
+          for (const unsigned int j : search.intersecting(
+                 grown_box(std::vector<Point<dim>>{sides[0][i].centre},
+                           0.5 * (sides[0][i].length + h))))
+            if (sides[0][i].centre.distance(sides[1][j].centre) <
+                0.5 * (sides[0][i].length + sides[1][j].length))
+              facing.emplace_back(i, j);
         for (bool changed = true; changed;)
           {
             changed = false;

@@ -201,8 +201,23 @@ namespace knee_contact
           {
             ++r.n_active;
             r.contact_length += pairs.rows[p].length;
-            r.max_pressure = std::max(r.max_pressure, results.pressure[p]);
+            if (results.pressure[p] > r.max_pressure)
+              {
+                r.max_pressure  = results.pressure[p];
+                r.peak_location = pairs.points[p].position;
+              }
           }
+        for (unsigned int d = 0; d < dim; ++d)
+          r.centre_of_pressure[d] +=
+            contact.lambda[p] * pairs.points[p].position[d];
+      }
+    for (InterfaceResult<dim> &r : results.interfaces)
+      {
+        if (r.force > 0)
+          r.centre_of_pressure /= r.force;
+        else
+          r.centre_of_pressure = Point<dim>();
+        r.mean_pressure = r.contact_length > 0 ? r.force / r.contact_length : 0;
       }
     return results;
   }

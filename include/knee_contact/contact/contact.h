@@ -193,6 +193,13 @@ namespace knee_contact
     void
     check_parameters() const;
 
+    /**
+     * Throw if an interface asks for what the mesh's dimension @p dim
+     * lacks: friction in 3D.
+     */
+    void
+    check_dimension(const unsigned int dim) const;
+
     /** 'Number of interfaces' as the scene gives it. */
     unsigned int n_interfaces = 0;
 
@@ -208,7 +215,8 @@ namespace knee_contact
     /**
      * Pair every slave vertex of every interface (see ContactPoint), and
      * choose each row's eliminated dof given the Gamma_u/Gamma_o
-     * @p constraints (closed). 2D only so far (see the specialisations).
+     * @p constraints (closed). 2D and 3D; friction rows in 2D only (3D
+     * friction is refused by check_dimension()).
      */
     template <int dim>
     ContactPairs<dim>
@@ -225,29 +233,6 @@ namespace knee_contact
     std::vector<ContactInterface> list;
   };
 
-  /**
-   * The rows of the 2D discretisations (contact_sides.h): segments of the
-   * boundary curves.
-   */
-  template <>
-  ContactPairs<2>
-  ContactInterfaces::make_pairs<2>(
-    const DoFHandler<2>             &dof_handler,
-    const AffineConstraints<double> &constraints) const;
-
-  /**
-   * 3D contact needs what 2D does with segments on faces: averaged vertex
-   * normals of surface meshes, the projection of a slave vertex onto master
-   * triangles and quadrilaterals (node-to-segment), and for mortar the
-   * clipping of slave and master face polygons on an auxiliary plane
-   * (Puso-Laursen; 4C's Coupling3d, Kratos' ExactMortarIntegrationUtility).
-   * Until it exists a 3D scene with interfaces is refused.
-   */
-  template <>
-  ContactPairs<3>
-  ContactInterfaces::make_pairs<3>(
-    const DoFHandler<3>             &dof_handler,
-    const AffineConstraints<double> &constraints) const;
 } // namespace knee_contact
 
 #endif

@@ -90,8 +90,9 @@ namespace knee_contact
      * both directions until nothing changes, so the two sides stay about
      * equally fine (node-to-segment pairing handles any mismatch left).
      */
+    template <int dim>
     void
-    mark_partners(Triangulation<2>        &triangulation,
+    mark_partners(Triangulation<dim>      &triangulation,
                   const ContactInterfaces &interfaces) const;
 
     double refine_fraction = 0.5;

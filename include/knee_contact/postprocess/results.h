@@ -35,8 +35,20 @@ namespace knee_contact
     /** The force vector on the slave body, -sum lambda_p n_p [N/m]. */
     Tensor<1, dim> force_on_slave;
     double         max_pressure = 0;
-    /** Length of slave boundary in contact, sum of the active shares [m]. */
+    /**
+     * Length (2D) or area (3D) of slave boundary in contact, sum of the
+     * active shares [m or m^2].
+     */
     double contact_length = 0;
+    /** Where the peak pressure is: its slave vertex. */
+    Point<dim> peak_location;
+    /**
+     * The centre of pressure: the slave vertices weighted by their contact
+     * forces, sum lambda_p x_p / sum lambda_p (the origin without force).
+     */
+    Point<dim> centre_of_pressure;
+    /** force / contact_length [Pa] (0 without contact). */
+    double mean_pressure = 0;
     /**
      * With friction (on any interface: friction is true and the figures
      * are those of every interface): the tangential force on the slave body,
