@@ -345,6 +345,14 @@ namespace knee_contact
   {
     ContactPairs<dim>                 pairs;
     std::set<types::global_dof_index> eliminated;
+    // The dofs of the rows that eliminate a master dof (rows of slave
+    // vertices that Gamma_u/Gamma_o hold along the normal). A master dof a
+    // later such row eliminates must not appear in an earlier one: then
+    // each refers only to dofs eliminated before it and no set of active
+    // rows forms a cycle of constraints. (2D has such a row at a held
+    // corner; 3D along a held edge, neighbours sharing master dofs.) Rows
+    // that eliminate their own slave dof refer to no other slave dof.
+    std::set<types::global_dof_index> in_master_rows;
     const bool                        friction =
       std::any_of(list.begin(), list.end(), [](const ContactInterface &i) {
         return i.friction != Friction::none;
@@ -400,6 +408,8 @@ namespace knee_contact
             // coefficient, else the largest free other component.
             const auto choose = [&](ContactRow &row) {
               reduce_row(row, constraints);
+              // The slave side first, then the master side avoiding the
+              // earlier master rows' dofs.
               for (const bool slave_side : {true, false})
                 {
                   double largest = 0;
@@ -409,6 +419,7 @@ namespace knee_contact
                         std::find(slave_dofs.begin(), slave_dofs.end(), dof) !=
                         slave_dofs.end();
                       if (on_slave == slave_side && !eliminated.count(dof) &&
+                          (slave_side || !in_master_rows.count(dof)) &&
                           std::abs(a) > largest + 1e-12)
                         {
                           largest        = std::abs(a);
@@ -416,10 +427,35 @@ namespace knee_contact
                         }
                     }
                   if (row.eliminated != numbers::invalid_dof_index)
-                    break;
+                    {
+                      row.slave_eliminated = slave_side;
+                      break;
+                    }
                 }
+              // No choice left: the rows of held slave vertices would
+              // eliminate master dofs in terms of each other (a cycle no
+              // set of constraint lines can hold).
+              AssertThrow(row.eliminated != numbers::invalid_dof_index ||
+                            std::all_of(row.reduced_row.begin(),
+                                        row.reduced_row.end(),
+                                        [&](const auto &entry) {
+                                          return eliminated.count(entry.first) >
+                                                 0;
+                                        }),
+                          ExcMessage(
+                            where + "the slave vertex at " +
+                            point_text(rows.points[p].position) +
+                            " is held along its normal by the boundary "
+                            "conditions, and so are its neighbours: their "
+                            "contact rows constrain the same master dofs and "
+                            "cannot all be held (make the other side the "
+                            "slave, or leave the slave side free along the "
+                            "contact normal)"));
               if (row.eliminated != numbers::invalid_dof_index)
                 eliminated.insert(row.eliminated);
+              if (!row.slave_eliminated)
+                for (const auto &entry : row.reduced_row)
+                  in_master_rows.insert(entry.first);
             };
             // A sticking pair holds both rows; as rows they would
             // eliminate the slave's two components in terms of each other

@@ -2,14 +2,15 @@
 // bodies share no nodes): the lower [0,1]^3 and the upper [0,1]^2 x [1,2],
 // n_lower and n_upper cells along each edge, hexahedra (hex_* = 1,
 // transfinite and recombined) or tetrahedra (hex_* = 0), the whole stack
-// rotated by angle [rad] about the skew axis (1, 2, 3) through the origin.
+// rotated by angle [rad] about the skew axis (1, 2, 3) through the origin;
+// the upper cube raised by gap (lowered into the lower one if negative).
 // The points are placed rotated (gmsh's Rotate renumbers OpenCASCADE
 // entities, which would lose the physical groups).
 // Physical volumes: 1 lower, 2 upper. Physical surfaces (before rotation):
 // 1: x = 0, 2: y = 0, 3: z = 0, 4: z = 2, 5: top of the lower cube,
 // 6: bottom of the upper cube, 7: x = 1, 8: y = 1.
 DefineConstant[ n_lower = 5, n_upper = 7, hex_lower = 1, hex_upper = 1,
-                angle = 0 ];
+                angle = 0, gap = 0 ];
 // Rodrigues: R = c I + s [a]x + (1 - c) a a^T, a = (1, 2, 3) / sqrt(14).
 a1 = 1 / Sqrt(14); a2 = 2 / Sqrt(14); a3 = 3 / Sqrt(14);
 c = Cos(angle); s = Sin(angle);
@@ -25,7 +26,7 @@ For b In {0 : 1}
   For k In {0 : 1}
     For j In {0 : 1}
       For i In {0 : 1}
-        x = i; y = j; z = k + b;
+        x = i; y = j; z = k + b * (1 + gap);
         Point(100 * b + 1 + i + 2 * j + 4 * k) =
           {r11 * x + r12 * y + r13 * z, r21 * x + r22 * y + r23 * z,
            r31 * x + r32 * y + r33 * z};

@@ -5,7 +5,8 @@
 // Gamma_u, and the one point that satisfies every KKT condition (A x <= g,
 // multipliers >= 0) is the reference. Asserted: the program's x equals it to
 // 1e-10 relative, and so do the active sets. Done for node-to-segment rows
-// (qp_scene.prm) and for mortar rows (qp_scene_mortar.prm).
+// (qp_scene.prm) and for mortar rows (qp_scene_mortar.prm), and for 3D
+// mortar rows (qp_scene_3d.prm).
 
 #include <knee_contact/core/problem.h>
 
@@ -23,12 +24,13 @@ using namespace knee_contact;
 
 namespace
 {
+  template <int dim>
   bool
   check(const std::string &scene)
   {
     std::cout << "scene " << scene << std::endl;
-    ContactProblem<2> problem(SOURCE_DIR "/" + scene);
-    const int         status = problem.run();
+    ContactProblem<dim> problem(SOURCE_DIR "/" + scene);
+    const int           status = problem.run();
 
     const auto        &K     = problem.matrix();
     const auto        &f     = problem.rhs();
@@ -139,7 +141,9 @@ int
 main()
 {
   // Node-to-segment rows, then mortar rows of the same scene.
-  const bool node_to_segment = check("qp_scene.prm");
-  const bool mortar          = check("qp_scene_mortar.prm");
-  return node_to_segment && mortar ? 0 : 1;
+  const bool node_to_segment = check<2>("qp_scene.prm");
+  const bool mortar          = check<2>("qp_scene_mortar.prm");
+  // 3D mortar rows (polygon clipping) on non-matching hexahedra.
+  const bool mortar_3d = check<3>("qp_scene_3d.prm");
+  return node_to_segment && mortar && mortar_3d ? 0 : 1;
 }

@@ -35,10 +35,11 @@ namespace
     double          contrast = 1;
   };
 
+  template <int dim>
   Run
   run(const std::string &scene, const ActiveSetSolver::LinearSolver solver)
   {
-    ContactProblem<2> problem(SOURCE_DIR "/" + scene);
+    ContactProblem<dim> problem(SOURCE_DIR "/" + scene);
     problem.contact_solver().set_linear_solver(solver);
     Run result;
     // The runs' own tables are not part of this test's output.
@@ -108,11 +109,12 @@ namespace
     return ok;
   }
 
+  template <int dim>
   bool
   compare(const std::string &scene)
   {
     using Path            = ActiveSetSolver::LinearSolver;
-    const Run    step41   = run(scene, Path::step41);
+    const Run    step41   = run<dim>(scene, Path::step41);
     unsigned int n_active = 0;
     for (const bool a : step41.contact.active)
       n_active += a;
@@ -124,7 +126,7 @@ namespace
     for (const Path path : {Path::condensed, Path::sparse, Path::automatic})
       {
         std::string why;
-        const bool  ok = agrees(step41, run(scene, path), why);
+        const bool  ok = agrees(step41, run<dim>(scene, path), why);
         std::cout << ", " << solver_path_name(path) << " "
                   << (ok ? "same" : "DIFFERENT");
         if (!ok)
@@ -161,8 +163,20 @@ main()
                           "../../prm/hard/many_pairs.prm",
                           "../../prm/hard/thin_layer.prm",
                           "../../prm/hard/zero_load.prm"};
-  bool        all      = true;
+  // 3D: the contact patch tests (mortar on hexahedra and tetrahedra,
+  // rotated; node-to-segment, node-to-node) and the Hertz sphere (an active
+  // set found from a point contact over several iterations).
+  const char *scenes_3d[] = {"../scenes/contact_patch_3d_hex.prm",
+                             "../scenes/contact_patch_3d_hex_rotated.prm",
+                             "../scenes/contact_patch_3d_tet.prm",
+                             "../scenes/contact_patch_3d_tet_rotated.prm",
+                             "../scenes/contact_patch_3d_matching.prm",
+                             "../scenes/contact_patch_3d_nodes.prm",
+                             "../scenes/hertz_sphere_3d_small.prm"};
+  bool        all         = true;
   for (const std::string scene : scenes)
-    all = compare(scene) && all;
+    all = compare<2>(scene) && all;
+  for (const std::string scene : scenes_3d)
+    all = compare<3>(scene) && all;
   return all ? 0 : 1;
 }
