@@ -278,8 +278,9 @@ namespace knee_contact
     // occur in deal.II's meshes; 3D faces carry 3 or 4 vertices.
     template <int dim>
     ContactSides<dim>
-    collect_sides(const DoFHandler<dim>  &dof_handler,
-                  const ContactInterface &interface)
+    collect_sides(const DoFHandler<dim>           &dof_handler,
+                  const ContactInterface          &interface,
+                  const AffineConstraints<double> &constraints)
     {
       using Face = typename ContactSides<dim>::Face;
       ContactSides<dim> sides;
@@ -331,6 +332,31 @@ namespace knee_contact
               else
                 sides.master_faces.push_back(side);
             }
+      // 3D: hanging slave vertices, their x component's line referring to
+      // the x components of other slave vertices only.
+      if constexpr (dim == 3)
+        {
+          std::map<types::global_dof_index, unsigned int> vertex_of_x_dof;
+          for (const auto &[key, vertex] : sides.slaves)
+            vertex_of_x_dof[vertex.dofs[0]] = key;
+          for (auto &[key, vertex] : sides.slaves)
+            if (constraints.is_constrained(vertex.dofs[0]))
+              {
+                std::vector<std::pair<unsigned int, double>> parents;
+                for (const auto &[dof, c] :
+                     *constraints.get_constraint_entries(vertex.dofs[0]))
+                  {
+                    const auto parent = vertex_of_x_dof.find(dof);
+                    if (parent == vertex_of_x_dof.end())
+                      {
+                        parents.clear();
+                        break;
+                      }
+                    parents.emplace_back(parent->second, c);
+                  }
+                vertex.parents = std::move(parents);
+              }
+        }
       return sides;
     }
   } // namespace
@@ -362,7 +388,7 @@ namespace knee_contact
       {
         const ContactInterface &interface = list[i];
         const ContactSides<dim> sides =
-          collect_sides<dim>(dof_handler, interface);
+          collect_sides<dim>(dof_handler, interface, constraints);
         const std::string where = "Contact/Interface " + std::to_string(i) +
                                   " ('" + interface.name + "'): ";
         AssertThrow(!sides.slaves.empty() && !sides.master_faces.empty(),
@@ -432,25 +458,50 @@ namespace knee_contact
                       break;
                     }
                 }
-              // No choice left: the rows of held slave vertices would
-              // eliminate master dofs in terms of each other (a cycle no
-              // set of constraint lines can hold).
-              AssertThrow(row.eliminated != numbers::invalid_dof_index ||
-                            std::all_of(row.reduced_row.begin(),
-                                        row.reduced_row.end(),
-                                        [&](const auto &entry) {
-                                          return eliminated.count(entry.first) >
-                                                 0;
-                                        }),
-                          ExcMessage(
-                            where + "the slave vertex at " +
-                            point_text(rows.points[p].position) +
-                            " is held along its normal by the boundary "
-                            "conditions, and so are its neighbours: their "
-                            "contact rows constrain the same master dofs and "
-                            "cannot all be held (make the other side the "
-                            "slave, or leave the slave side free along the "
-                            "contact normal)"));
+              // No choice left. A slave vertex that hangs on a refined
+              // neighbour's edge or face refers to its parents' dofs: as
+              // before, its row eliminates the largest free dof left (the
+              // active-set loop finds a cycle if one forms). A slave vertex
+              // that Gamma_u/Gamma_o hold (its lines refer to its own dofs
+              // only) would eliminate master dofs in terms of those its held
+              // neighbours eliminate, a cycle no set of constraint lines
+              // can hold: refused.
+              const bool free_dof_left =
+                std::any_of(row.reduced_row.begin(),
+                            row.reduced_row.end(),
+                            [&](const auto &entry) {
+                              return eliminated.count(entry.first) == 0;
+                            });
+              if (row.eliminated == numbers::invalid_dof_index && free_dof_left)
+                {
+                  bool held = true;
+                  for (const auto dof : slave_dofs)
+                    if (constraints.is_constrained(dof))
+                      for (const auto &entry :
+                           *constraints.get_constraint_entries(dof))
+                        held =
+                          held && std::find(slave_dofs.begin(),
+                                            slave_dofs.end(),
+                                            entry.first) != slave_dofs.end();
+                  AssertThrow(!held,
+                              ExcMessage(
+                                where + "the slave vertex at " +
+                                point_text(rows.points[p].position) +
+                                " is held along its normal by the boundary "
+                                "conditions, and so are its neighbours: their "
+                                "contact rows constrain the same master dofs "
+                                "and cannot all be held (make the other side "
+                                "the slave, or leave the slave side free along "
+                                "the contact normal)"));
+                  double largest = 0;
+                  for (const auto &[dof, a] : row.reduced_row)
+                    if (!eliminated.count(dof) && std::abs(a) > largest + 1e-12)
+                      {
+                        largest              = std::abs(a);
+                        row.eliminated       = dof;
+                        row.slave_eliminated = false;
+                      }
+                }
               if (row.eliminated != numbers::invalid_dof_index)
                 eliminated.insert(row.eliminated);
               if (!row.slave_eliminated)

@@ -364,6 +364,27 @@ namespace knee_contact
           }
       }
 
+    // A hanging slave vertex's multiplier is its parents' (the multiplier
+    // space is the constrained trace space): its sums go to its parents with
+    // the weights of its constraint, u_h = sum_q c_q u_q, and it gets no row.
+    for (const auto &[key, vertex] : sides.slaves)
+      if (!vertex.parents.empty())
+        {
+          const auto hanging = rows.find(key);
+          if (hanging == rows.end())
+            continue;
+          const m3::Accumulator sums = hanging->second;
+          rows.erase(hanging);
+          for (const auto &[parent, c] : vertex.parents)
+            {
+              m3::Accumulator &row = rows[parent];
+              row.weight += c * sums.weight;
+              row.gap += c * sums.gap;
+              for (const auto &[dofs, M] : sums.master)
+                row.master[dofs] += c * M;
+            }
+        }
+
     // Normalised and D lumped as in 2D (mortar.cc, which says why).
     ContactPairs<3> pairs;
     for (const auto &[key, row] : rows)

@@ -177,6 +177,9 @@ namespace knee_contact
     ContactPairs<3> pairs;
     for (const auto &[vertex, slave] : sides.slaves)
       {
+        // A hanging slave vertex follows its parents, whose rows hold it.
+        if (!slave.parents.empty())
+          continue;
         const Tensor<1, 3> n = slave.unit_normal();
         // The vertex's spacing: the side of a square of its area share.
         const double h = std::sqrt(slave.length);

@@ -41,6 +41,14 @@ namespace knee_contact
       /** The vertex's share of its faces: sum of measure / n_vertices. */
       double                                   length = 0;
       std::array<types::global_dof_index, dim> dofs;
+      /**
+       * 3D: a vertex that hangs on a refined neighbour's edge or face, the
+       * slave vertices its displacement is interpolated from and their
+       * weights (its hanging-node constraint); empty for a vertex of its
+       * own. Its multiplier is not a free one either: the 3D rows fold its
+       * share into its parents'.
+       */
+      std::vector<std::pair<unsigned int, double>> parents;
 
       Tensor<1, dim>
       unit_normal() const
