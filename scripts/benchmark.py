@@ -26,6 +26,11 @@ Scene "adaptive" refines the knees adaptively (ADAPTIVE below) past 4e5
 dofs and prints per cycle the path taken, the contact solve against one
 linear solve of the same cycle, iterations and memory (from study.csv).
 
+Scenes "hertz3d" (prm/hertz_sphere_3d.prm) and "knee3d" (prm/knee_3d.prm)
+are 3D: tetrahedra of gmsh, so each size is a new mesh of the .geo
+(h_contact divided by sqrt 2 a step, about 2.8 times the dofs) instead of a
+global refinement; the same table.
+
 Scene "gait" (prm/knee_gait.prm with 11 load cases t = 0:0.1:1) measures
 load cases: per size the first case (assembly and contact solve), the
 median further case (load vector assembly, condensation, active-set loop
@@ -52,8 +57,19 @@ SCENES = {
               {(("Mesh",), "Gmsh arguments"):
                "-setnumber lc_fine 0.02 -setnumber lc_coarse 0.1"}),
     "knee": ("prm/knee.prm", {}),
+    "hertz3d": ("prm/hertz_sphere_3d.prm", {}),
+    "knee3d": ("prm/knee_3d.prm", {}),
     "gait": ("prm/knee_gait.prm", {(("Load cases",), "Values of t"):
                                    "0:0.1:1"}),
+}
+
+# The 3D scenes' sizes: gmsh arguments per size (tetrahedra are meshed anew,
+# not refined).
+SIZES_3D = {
+    "hertz3d": ["-setnumber h_contact %g" % h
+                for h in (0.04, 0.028, 0.02, 0.014, 0.01, 0.007, 0.005)],
+    "knee3d": ["-setnumber h_contact %g -setnumber h_far %g" % (h, 5 * h)
+               for h in (2.4, 1.7, 1.2, 0.85, 0.6, 0.42)],
 }
 
 # The adaptive series (--scenes adaptive): both knees refined adaptively
@@ -264,9 +280,13 @@ def main():
         scene, base = SCENES[name]
         rows = []
         with tempfile.TemporaryDirectory(prefix="benchmark-") as work:
-            for level in range(10):
+            levels = SIZES_3D.get(name, range(10))
+            for level in levels:
                 changes = dict(base)
-                changes[("Mesh",), "Global refinements"] = str(level)
+                if name in SIZES_3D:
+                    changes[("Mesh",), "Gmsh arguments"] = level
+                else:
+                    changes[("Mesh",), "Global refinements"] = str(level)
                 changes[("Contact",), "Solver"] = args.solver
                 changes[("Contact",), "Reference solve"] = "true"
                 row = median_run(program, scene, changes, work, args.repeat)
@@ -281,7 +301,8 @@ def main():
                 rows.append(row)
                 print("%s: %d dofs done" % (name, row["dofs"]),
                       file=sys.stderr, flush=True)
-                if 4 * row["dofs"] > args.max_dofs:
+                growth = 2.83 if name in SIZES_3D else 4
+                if growth * row["dofs"] > args.max_dofs:
                     break
 
         print("\n%s (%s), median of %d run(s)" % (name, scene, args.repeat))
