@@ -33,13 +33,17 @@ def draw(folder):
                        key=lambda s: int(s))
 
     friction = [n for n in interfaces if n + "_max_slip" in columns]
+    # 3D: contact areas [m^2] (shown in mm^2), forces in N, the load along z.
+    three_d = "load_z" in columns
+    measure, scale = (("_contact_area", 1e6) if three_d
+                      else ("_contact_length", 1e3))
     figure, axes = plt.subplots(4 if friction else 3, 1,
                                 figsize=(7, 12 if friction else 9),
                                 sharex=True)
     for name in interfaces:
         axes[0].plot(t, [float(r[name + "_peak_pressure"]) / 1e6
                          for r in rows], "o-", ms=3, label=name)
-        line, = axes[1].plot(t, [float(r[name + "_contact_length"]) * 1e3
+        line, = axes[1].plot(t, [float(r[name + measure]) * scale
                                  for r in rows], "o-", ms=3, label=name)
         if name in friction:
             axes[1].plot(t, [float(r[name + "_stick_length"]) * 1e3
@@ -55,15 +59,18 @@ def draw(folder):
     if friction:
         axes[3].set_ylabel("slip [um]")
     axes[0].set_ylabel("peak contact pressure [MPa]")
-    axes[1].set_ylabel("contact length [mm]")
-    for component, style in (("y", "-"), ("x", "--")):
+    axes[1].set_ylabel("contact area [mm^2]" if three_d
+                       else "contact length [mm]")
+    components = (("z", "-"), ("x", "--"), ("y", ":")) if three_d \
+        else (("y", "-"), ("x", "--"))
+    for component, style in components:
         axes[2].plot(t, [float(r["load_" + component]) / 1e3 for r in rows],
                      "k" + style, label="applied load " + component)
         for b in reactions:
             axes[2].plot(t, [float(r["reaction_%s_%s" % (b, component)]) / 1e3
                              for r in rows], style, marker="o", ms=3,
                          label="reaction id %s %s" % (b, component))
-    axes[2].set_ylabel("force [kN/m]")
+    axes[2].set_ylabel("force [kN]" if three_d else "force [kN/m]")
     axes[-1].set_xlabel("load parameter t")
     for a in axes:
         a.grid(True, alpha=0.3)

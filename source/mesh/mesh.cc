@@ -317,15 +317,15 @@ namespace knee_contact
     const bool tetrahedra =
       dim == 3 && triangulation.all_reference_cells_are_simplex();
     check_run_fits(dim,
-                   (tetrahedra ? 2. * triangulation.n_vertices() :
-                                 double(triangulation.n_active_cells())) *
+                   (tetrahedra ? 2. * triangulation.n_vertices()
+                               : double(triangulation.n_active_cells())) *
                      std::pow(double(1u << dim), n_refine),
                    (n_refine > 0 ? "Mesh/Global refinements: " +
                                      std::to_string(n_refine) + " refinements"
                                  : std::string("Mesh: the scene's mesh")) +
                      (tetrahedra ? " (tetrahedra: as hexahedra of twice its "
-                                   "vertices)" :
-                                   ""));
+                                   "vertices)"
+                                 : ""));
     triangulation.refine_global(n_refine);
     if (n_refine > 0)
       check_cells(triangulation);

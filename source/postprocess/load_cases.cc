@@ -114,7 +114,8 @@ namespace knee_contact
     for (const auto &i : first.interfaces)
       {
         out << ',' << i.name << "_active_pairs," << i.name << "_force,"
-            << i.name << "_peak_pressure," << i.name << "_contact_length";
+            << i.name << "_peak_pressure," << i.name
+            << (dim == 2 ? "_contact_length" : "_contact_area");
         if (i.friction)
           out << ',' << i.name << "_stick_length," << i.name << "_slip_length,"
               << i.name << "_max_slip," << i.name << "_max_accumulated_slip";
@@ -153,11 +154,16 @@ namespace knee_contact
                          const bool                      with_times,
                          std::ostream                   &out)
   {
+    // 3D: energies in J and contact areas in m^2.
     out << "load cases:\n"
-        << "  case          t  iterations  energy [J/m]  peak pressure [Pa]"
-           "  contact length [m]"
-        << (with_times ? "  energy bar [J/m]  peak bar [Pa]  solve [s]" : "")
-        << '\n';
+        << (dim == 2 ? "  case          t  iterations  energy [J/m]"
+                       "  peak pressure [Pa]  contact length [m]"
+                     : "  case          t  iterations    energy [J]"
+                       "  peak pressure [Pa]  contact area [m^2]")
+        << (with_times
+              ? (dim == 2 ? "  energy bar [J/m]" : "    energy bar [J]")
+              : "")
+        << (with_times ? "  peak bar [Pa]  solve [s]" : "") << '\n';
     for (unsigned int c = 0; c < records.size(); ++c)
       {
         const Record<dim> &r    = records[c];
