@@ -431,8 +431,12 @@ namespace knee_contact
                   }
               }
             // Eliminate the free slave component with the largest
-            // coefficient, else the largest free other component.
-            const auto choose = [&](ContactRow &row) {
+            // coefficient, else the largest free other component. A normal
+            // row (@p normal) eliminates no master dof of an earlier normal
+            // row; a frictional pair's tangential row is never active with
+            // its normal row and is exempt (it may eliminate another dof of
+            // the same master face).
+            const auto choose = [&](ContactRow &row, const bool normal) {
               reduce_row(row, constraints);
               // The slave side first, then the master side avoiding the
               // earlier master rows' dofs.
@@ -445,7 +449,8 @@ namespace knee_contact
                         std::find(slave_dofs.begin(), slave_dofs.end(), dof) !=
                         slave_dofs.end();
                       if (on_slave == slave_side && !eliminated.count(dof) &&
-                          (slave_side || !in_master_rows.count(dof)) &&
+                          (slave_side || !normal ||
+                           !in_master_rows.count(dof)) &&
                           std::abs(a) > largest + 1e-12)
                         {
                           largest        = std::abs(a);
@@ -466,13 +471,18 @@ namespace knee_contact
               // only) would eliminate master dofs in terms of those its held
               // neighbours eliminate, a cycle no set of constraint lines
               // can hold: refused.
+              // (As in the passes above, a coefficient of 1e-12 or less is
+              // round-off, no dof to eliminate. A tangential row is left as
+              // it was.)
               const bool free_dof_left =
                 std::any_of(row.reduced_row.begin(),
                             row.reduced_row.end(),
                             [&](const auto &entry) {
-                              return eliminated.count(entry.first) == 0;
+                              return eliminated.count(entry.first) == 0 &&
+                                     std::abs(entry.second) > 1e-12;
                             });
-              if (row.eliminated == numbers::invalid_dof_index && free_dof_left)
+              if (normal && row.eliminated == numbers::invalid_dof_index &&
+                  free_dof_left)
                 {
                   bool held = true;
                   for (const auto dof : slave_dofs)
@@ -504,7 +514,7 @@ namespace knee_contact
                 }
               if (row.eliminated != numbers::invalid_dof_index)
                 eliminated.insert(row.eliminated);
-              if (!row.slave_eliminated)
+              if (normal && !row.slave_eliminated)
                 for (const auto &entry : row.reduced_row)
                   in_master_rows.insert(entry.first);
             };
@@ -534,10 +544,10 @@ namespace knee_contact
                   x_row        = combine(c[0][0], c[0][1]);
                   y_row        = combine(c[1][0], c[1][1]);
                 }
-            choose(pair);
+            choose(pair, true);
             if (dim == 2 && friction)
               {
-                choose(slide);
+                choose(slide, false);
                 slide.measured_only = true;
                 tangential.push_back(std::move(slide));
                 // Never active together with the pair's N or T rows: they

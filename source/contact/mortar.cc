@@ -34,15 +34,6 @@ namespace knee_contact
 {
   namespace
   {
-    // One slave vertex's row while it is integrated: its weight
-    // W_j = int psi_j (= sum_i D_ji, as sum_i phi_i = 1), M_j. and g~_j.
-    struct Accumulator
-    {
-      double                                                   weight = 0;
-      std::map<std::array<types::global_dof_index, 2>, double> master;
-      double                                                   gap = 0;
-    };
-
     // The parts of [lo, hi] not covered by the intervals in taken.
     std::vector<std::pair<double, double>>
     uncovered(const double                                  lo,
@@ -80,9 +71,9 @@ namespace knee_contact
               const unsigned int      interface_index,
               const std::string      &where)
   {
-    std::map<unsigned int, Accumulator> rows;
-    const double                        g   = 1 / std::sqrt(3.);
-    const double                        tol = 1e-8 * sides.min_length;
+    std::map<unsigned int, MortarSums<2>> rows;
+    const double                          g   = 1 / std::sqrt(3.);
+    const double                          tol = 1e-8 * sides.min_length;
 
     for (const ContactSides<2>::Face &slave : sides.slave_faces)
       {
@@ -180,7 +171,7 @@ namespace knee_contact
                     for (unsigned int j = 0; j < 2; ++j)
                       {
                         const unsigned int key = slave.vertex_keys[j];
-                        Accumulator       &row = rows[key];
+                        MortarSums<2>     &row = rows[key];
                         row.weight += w * psi[j];
                         for (unsigned int k = 0; k < 2; ++k)
                           row.master[c.master->dofs[k]] +=
@@ -195,19 +186,31 @@ namespace knee_contact
           }
       }
 
-    ContactPairs<2> pairs;
-    for (const auto &[key, row] : rows)
+    return normalised_mortar_rows<2>(rows, sides, interface_index, tol);
+  }
+
+
+
+  template <int dim>
+  ContactPairs<dim>
+  normalised_mortar_rows(const std::map<unsigned int, MortarSums<dim>> &sums,
+                         const ContactSides<dim>                       &sides,
+                         const unsigned int interface_index,
+                         const double       tol)
+  {
+    ContactPairs<dim> pairs;
+    for (const auto &[key, row] : sums)
       {
-        const ContactSides<2>::SlaveVertex &vertex = sides.slaves.at(key);
-        const double                        weight = row.weight;
+        const auto  &vertex = sides.slaves.at(key);
+        const double weight = row.weight;
         // A vertex whose faces the master covers for less than a quarter of
         // its weight (at an interface end that overhangs the master) gets
         // no row: int psi_j over a small end piece can be tiny or negative.
         if (weight < 0.25 * vertex.length)
           continue;
-        const Tensor<1, 2> n   = vertex.unit_normal();
-        const double       gap = row.gap / weight;
-        ContactRow         pair;
+        const Tensor<1, dim> n   = vertex.unit_normal();
+        const double         gap = row.gap / weight;
+        ContactRow           pair;
         pair.interface = interface_index;
         pair.gap       = std::abs(gap) <= tol ? 0. : gap;
         pair.length    = weight;
@@ -219,14 +222,27 @@ namespace knee_contact
         // can hold). Lumping keeps sum_i D_ji = W_j, so rigid translations
         // stay free of the condition; it changes nothing where faces are
         // fully covered (D is diagonal there).
-        for (unsigned int d = 0; d < 2; ++d)
+        for (unsigned int d = 0; d < dim; ++d)
           pair.row.emplace_back(vertex.dofs[d], n[d]);
         for (const auto &[dofs, M] : row.master)
           if (M != 0)
-            for (unsigned int d = 0; d < 2; ++d)
+            for (unsigned int d = 0; d < dim; ++d)
               pair.row.emplace_back(dofs[d], -M / weight * n[d]);
         pairs.push_back(std::move(pair), {vertex.position, n, vertex.dofs, {}});
       }
     return pairs;
   }
+
+
+
+  template ContactPairs<2>
+  normalised_mortar_rows(const std::map<unsigned int, MortarSums<2>> &,
+                         const ContactSides<2> &,
+                         const unsigned int,
+                         const double);
+  template ContactPairs<3>
+  normalised_mortar_rows(const std::map<unsigned int, MortarSums<3>> &,
+                         const ContactSides<3> &,
+                         const unsigned int,
+                         const double);
 } // namespace knee_contact

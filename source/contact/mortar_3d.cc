@@ -191,12 +191,6 @@ namespace knee_contact
       return a;
     }
 
-    struct Accumulator
-    {
-      double                                                   weight = 0;
-      std::map<std::array<types::global_dof_index, 3>, double> master;
-      double                                                   gap = 0;
-    };
   } // namespace mortar_3d
 
 
@@ -214,14 +208,9 @@ namespace knee_contact
     const QGaussSimplex<2> rule(3); // degree 5
     const double           tol = 1e-8 * sides.min_length;
 
-    std::vector<BoundingBox<3>> boxes;
-    for (const Face &master : sides.master_faces)
-      boxes.emplace_back(
-        std::vector<Point<3>>(master.vertices.begin(),
-                              master.vertices.begin() + master.n_vertices));
-    const ContactSearch<3> search(boxes);
+    const ContactSearch<3> search = master_face_search(sides);
 
-    std::map<unsigned int, m3::Accumulator> rows;
+    std::map<unsigned int, MortarSums<3>> rows;
     for (const Face &slave : sides.slave_faces)
       {
         const double L = slave.diameter;
@@ -353,7 +342,7 @@ namespace knee_contact
                     for (unsigned int k = 0; k < slave.n_vertices; ++k)
                       psi += A(j, k) * phi[k];
                     const unsigned int key = slave.vertex_keys[j];
-                    m3::Accumulator   &row = rows[key];
+                    MortarSums<3>     &row = rows[key];
                     row.weight += w * psi;
                     for (unsigned int k = 0; k < master.n_vertices; ++k)
                       row.master[master.dofs[k]] += w * psi * phi_master[k];
@@ -373,11 +362,11 @@ namespace knee_contact
           const auto hanging = rows.find(key);
           if (hanging == rows.end())
             continue;
-          const m3::Accumulator sums = hanging->second;
+          const MortarSums<3> sums = hanging->second;
           rows.erase(hanging);
           for (const auto &[parent, c] : vertex.parents)
             {
-              m3::Accumulator &row = rows[parent];
+              MortarSums<3> &row = rows[parent];
               row.weight += c * sums.weight;
               row.gap += c * sums.gap;
               for (const auto &[dofs, M] : sums.master)
@@ -385,28 +374,7 @@ namespace knee_contact
             }
         }
 
-    // Normalised and D lumped as in 2D (mortar.cc, which says why).
-    ContactPairs<3> pairs;
-    for (const auto &[key, row] : rows)
-      {
-        const ContactSides<3>::SlaveVertex &vertex = sides.slaves.at(key);
-        const double                        weight = row.weight;
-        if (weight < 0.25 * vertex.length)
-          continue;
-        const Tensor<1, 3> n   = vertex.unit_normal();
-        const double       gap = row.gap / weight;
-        ContactRow         pair;
-        pair.interface = interface_index;
-        pair.gap       = std::abs(gap) <= tol ? 0. : gap;
-        pair.length    = weight;
-        for (unsigned int d = 0; d < 3; ++d)
-          pair.row.emplace_back(vertex.dofs[d], n[d]);
-        for (const auto &[dofs, M] : row.master)
-          if (M != 0)
-            for (unsigned int d = 0; d < 3; ++d)
-              pair.row.emplace_back(dofs[d], -M / weight * n[d]);
-        pairs.push_back(std::move(pair), {vertex.position, n, vertex.dofs, {}});
-      }
-    return pairs;
+    // Normalised and D lumped as in 2D.
+    return normalised_mortar_rows<3>(rows, sides, interface_index, tol);
   }
 } // namespace knee_contact

@@ -165,14 +165,9 @@ namespace knee_contact
                        const unsigned int      interface_index,
                        const std::string      &where)
   {
-    using Face = ContactSides<3>::Face;
-    std::vector<BoundingBox<3>> boxes;
-    for (const Face &master : sides.master_faces)
-      boxes.emplace_back(
-        std::vector<Point<3>>(master.vertices.begin(),
-                              master.vertices.begin() + master.n_vertices));
-    const ContactSearch<3> search(boxes);
-    const double           tol = 1e-8 * sides.min_length;
+    using Face                    = ContactSides<3>::Face;
+    const ContactSearch<3> search = master_face_search(sides);
+    const double           tol    = 1e-8 * sides.min_length;
 
     ContactPairs<3> pairs;
     for (const auto &[vertex, slave] : sides.slaves)

@@ -1,3 +1,4 @@
+#include <knee_contact/contact/contact_sides.h>
 #include <knee_contact/contact/search.h>
 
 #include <boost/geometry/index/rtree.hpp>
@@ -92,7 +93,25 @@ namespace knee_contact
 
 
 
+  template <int dim>
+  ContactSearch<dim>
+  master_face_search(const ContactSides<dim> &sides)
+  {
+    std::vector<BoundingBox<dim>> boxes;
+    for (const auto &face : sides.master_faces)
+      boxes.emplace_back(
+        std::vector<Point<dim>>(face.vertices.begin(),
+                                face.vertices.begin() + face.n_vertices));
+    return ContactSearch<dim>(boxes);
+  }
+
+
+
   template class ContactSearch<2>;
+  template ContactSearch<2>
+  master_face_search(const ContactSides<2> &);
+  template ContactSearch<3>
+  master_face_search(const ContactSides<3> &);
   template class ContactSearch<3>;
   template BoundingBox<2>
   grown_box(const std::vector<Point<2>> &, const double);

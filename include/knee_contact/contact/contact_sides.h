@@ -2,6 +2,7 @@
 #define knee_contact_contact_sides_h
 
 #include <knee_contact/contact/contact.h>
+#include <knee_contact/contact/search.h>
 #include <knee_contact/core/input.h>
 
 #include <deal.II/base/geometry_info.h>
@@ -137,6 +138,39 @@ namespace knee_contact
                        const ContactInterface  &interface,
                        const unsigned int       interface_index,
                        const std::string       &where);
+
+  /**
+   * One slave vertex's mortar row while it is integrated: its weight
+   * W_j = int psi_j (= sum_i D_ji, as sum_i phi_i = 1), M_j. by master
+   * vertex (its dofs) and the weighted gap g~_j.
+   */
+  template <int dim>
+  struct MortarSums
+  {
+    double                                                     weight = 0;
+    std::map<std::array<types::global_dof_index, dim>, double> master;
+    double                                                     gap = 0;
+  };
+
+  /**
+   * The rows of the integrated sums (2D and 3D alike, mortar.cc): each
+   * divided by its weight W_j and D lumped onto the diagonal; a vertex whose
+   * faces the master covers for less than a quarter of its share gets no
+   * row; gaps within @p tol of zero are zero.
+   */
+  template <int dim>
+  ContactPairs<dim>
+  normalised_mortar_rows(const std::map<unsigned int, MortarSums<dim>> &sums,
+                         const ContactSides<dim>                       &sides,
+                         const unsigned int interface_index,
+                         const double       tol);
+
+  /** The contact search over the master faces of @p sides (search.h). */
+  template <int dim>
+  ContactSearch<dim>
+  master_face_search(const ContactSides<dim> &sides);
+
+
 
   /**
    * Dual mortar rows (segment-to-segment, Wohlmuth's biorthogonal
