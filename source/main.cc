@@ -13,8 +13,8 @@
 #include <stdexcept>
 #include <system_error>
 
-// knee_contact: unilateral contact between linear elastic bodies in 2D, and
-// linear elasticity in 3D (the dimension comes from the mesh).
+// knee_contact: unilateral contact between linear elastic bodies in 2D and
+// 3D (the dimension comes from the mesh; friction in 2D).
 // Usage: knee_contact [--dry-run] scene.prm | --help | --print-parameters
 namespace
 {
