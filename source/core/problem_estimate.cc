@@ -324,6 +324,7 @@ namespace knee_contact
     for (unsigned int q = 0; q < contact_pairs.size(); ++q)
       pair_of_dof[contact_pairs.points[q].slave_dofs[0]] = q;
     std::set<std::pair<unsigned int, unsigned int>> edges;
+    std::set<unsigned int>                          outline;
     std::vector<double> bars(results.interfaces.size(), 0.);
     for (const auto &cell : dof_handler.active_cell_iterators())
       for (const auto &face : cell->face_iterators())
@@ -343,10 +344,24 @@ namespace knee_contact
                     contact_pairs.rows[a].interface ==
                       contact_pairs.rows[b].interface &&
                     edges.emplace(a, b).second)
-                  bars[contact_pairs.rows[a].interface] +=
-                    0.5 * (contact_pairs.rows[a].length +
-                           contact_pairs.rows[b].length);
+                  {
+                    if constexpr (dim == 2)
+                      bars[contact_pairs.rows[a].interface] +=
+                        0.5 * (contact_pairs.rows[a].length +
+                               contact_pairs.rows[b].length);
+                    else
+                      outline.insert({a, b});
+                  }
           }
+    // 3D: the zone's outline is a band, one spacing wide: half the share of
+    // every vertex on either side of it, each once. (Summed per crossing
+    // pair, as in 2D, a vertex with two or three neighbours across counted
+    // two or three times: on the Hertz sphere's tetrahedra, 9 249 to
+    // 123 438 dofs, that bar was 34 to 12 times the area's difference from
+    // Hertz, this one is 18 to 6 times.)
+    for (const unsigned int q : outline)
+      bars[contact_pairs.rows[q].interface] +=
+        0.5 * contact_pairs.rows[q].length;
     for (unsigned int i = 0; i < results.interfaces.size(); ++i)
       if (results.interfaces[i].n_active > 0)
         {
@@ -354,7 +369,10 @@ namespace knee_contact
           bar.value      = results.interfaces[i].contact_length;
           bar.error      = bars[i];
           bar.asymptotic = true;
-          bar.basis      = "one slave spacing at each edge of the contact zone";
+          bar.basis      = dim == 2
+                             ? "one slave spacing at each edge of the contact zone"
+                             : "a band one slave spacing wide along the contact "
+                               "zone's outline";
           keep("interface " + results.interfaces[i].name + ": contact length",
                bar);
         }
