@@ -274,6 +274,22 @@ namespace knee_contact
       pair.reduced_gap = rhs;
     }
 
+    // Whether every line of the constrained ones among a vertex's dofs
+    // refers to that vertex's dofs only (Gamma_u, or Gamma_o on a plane
+    // through it), not to other vertices (a hanging node).
+    template <std::size_t n>
+    bool
+    held_by_conditions(const std::array<types::global_dof_index, n> &dofs,
+                       const AffineConstraints<double> &constraints)
+    {
+      for (const auto dof : dofs)
+        if (constraints.is_constrained(dof))
+          for (const auto &entry : *constraints.get_constraint_entries(dof))
+            if (std::find(dofs.begin(), dofs.end(), entry.first) == dofs.end())
+              return false;
+      return true;
+    }
+
     // Faces that are neither segments, triangles nor quadrilaterals cannot
     // occur in deal.II's meshes; 3D faces carry 3 or 4 vertices.
     template <int dim>
@@ -438,18 +454,30 @@ namespace knee_contact
             // the same master face).
             const auto choose = [&](ContactRow &row, const bool normal) {
               reduce_row(row, constraints);
-              // The slave side first, then the master side avoiding the
-              // earlier master rows' dofs.
-              for (const bool slave_side : {true, false})
+              // Pass 0: the slave side. Pass 1: the other dofs, for a
+              // normal row none that an earlier master row refers to.
+              // Pass 2 (normal rows where pass 1 found none): any free dof.
+              // That is a slave vertex hanging on a refined neighbour's
+              // edge or face, whose row refers to its parents' dofs (as
+              // before, the active-set loop finds a cycle if one forms);
+              // a slave vertex that Gamma_u/Gamma_o hold (its lines refer
+              // to its own dofs only) would eliminate master dofs in terms
+              // of those its held neighbours eliminate, a cycle no set of
+              // constraint lines can hold: refused. A coefficient of 1e-12
+              // or less is round-off, no dof to eliminate.
+              for (const unsigned int pass : {0, 1, 2})
                 {
+                  if (pass == 2 && !normal)
+                    break;
                   double largest = 0;
                   for (const auto &[dof, a] : row.reduced_row)
                     {
                       const bool on_slave =
                         std::find(slave_dofs.begin(), slave_dofs.end(), dof) !=
                         slave_dofs.end();
-                      if (on_slave == slave_side && !eliminated.count(dof) &&
-                          (slave_side || !normal ||
+                      if ((pass == 2 || on_slave == (pass == 0)) &&
+                          !eliminated.count(dof) &&
+                          (pass != 1 || !normal ||
                            !in_master_rows.count(dof)) &&
                           std::abs(a) > largest + 1e-12)
                         {
@@ -457,60 +485,21 @@ namespace knee_contact
                           row.eliminated = dof;
                         }
                     }
-                  if (row.eliminated != numbers::invalid_dof_index)
-                    {
-                      row.slave_eliminated = slave_side;
-                      break;
-                    }
-                }
-              // No choice left. A slave vertex that hangs on a refined
-              // neighbour's edge or face refers to its parents' dofs: as
-              // before, its row eliminates the largest free dof left (the
-              // active-set loop finds a cycle if one forms). A slave vertex
-              // that Gamma_u/Gamma_o hold (its lines refer to its own dofs
-              // only) would eliminate master dofs in terms of those its held
-              // neighbours eliminate, a cycle no set of constraint lines
-              // can hold: refused.
-              // (As in the passes above, a coefficient of 1e-12 or less is
-              // round-off, no dof to eliminate. A tangential row is left as
-              // it was.)
-              const bool free_dof_left =
-                std::any_of(row.reduced_row.begin(),
-                            row.reduced_row.end(),
-                            [&](const auto &entry) {
-                              return eliminated.count(entry.first) == 0 &&
-                                     std::abs(entry.second) > 1e-12;
-                            });
-              if (normal && row.eliminated == numbers::invalid_dof_index &&
-                  free_dof_left)
-                {
-                  bool held = true;
-                  for (const auto dof : slave_dofs)
-                    if (constraints.is_constrained(dof))
-                      for (const auto &entry :
-                           *constraints.get_constraint_entries(dof))
-                        held =
-                          held && std::find(slave_dofs.begin(),
-                                            slave_dofs.end(),
-                                            entry.first) != slave_dofs.end();
-                  AssertThrow(!held,
-                              ExcMessage(
-                                where + "the slave vertex at " +
-                                point_text(rows.points[p].position) +
-                                " is held along its normal by the boundary "
-                                "conditions, and so are its neighbours: their "
-                                "contact rows constrain the same master dofs "
-                                "and cannot all be held (make the other side "
-                                "the slave, or leave the slave side free along "
-                                "the contact normal)"));
-                  double largest = 0;
-                  for (const auto &[dof, a] : row.reduced_row)
-                    if (!eliminated.count(dof) && std::abs(a) > largest + 1e-12)
-                      {
-                        largest              = std::abs(a);
-                        row.eliminated       = dof;
-                        row.slave_eliminated = false;
-                      }
+                  if (row.eliminated == numbers::invalid_dof_index)
+                    continue;
+                  row.slave_eliminated = pass == 0;
+                  if (pass == 2)
+                    AssertThrow(!held_by_conditions(slave_dofs, constraints),
+                                ExcMessage(
+                                  where + "the slave vertex at " +
+                                  point_text(rows.points[p].position) +
+                                  " is held along its normal by the boundary "
+                                  "conditions, and so are its neighbours: "
+                                  "their contact rows constrain the same "
+                                  "master dofs and cannot all be held (make "
+                                  "the other side the slave, or leave the "
+                                  "slave side free along the contact normal)"));
+                  break;
                 }
               if (row.eliminated != numbers::invalid_dof_index)
                 eliminated.insert(row.eliminated);

@@ -230,7 +230,7 @@ namespace knee_contact
                                             slave.vertices.begin() +
                                               slave.n_vertices);
         for (const unsigned int m : search.near(
-               grown_box(corners, 0.), plane.centre, L, interface.maximum_gap))
+               BoundingBox<3>(corners), plane.centre, L, interface.maximum_gap))
           {
             const Face &master = sides.master_faces[m];
             if (master.normal * plane.normal >= 0)

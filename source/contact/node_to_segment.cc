@@ -180,7 +180,7 @@ namespace knee_contact
         const double h = std::sqrt(slave.length);
         MasterHit<3> hit;
         for (const unsigned int m :
-             search.near(grown_box(std::vector<Point<3>>{slave.position}, 0.),
+             search.near(BoundingBox<3>(std::vector<Point<3>>{slave.position}),
                          slave.position,
                          2 * h,
                          interface.maximum_gap))
@@ -201,13 +201,15 @@ namespace knee_contact
                 hit.face = &master;
               }
           }
+        const auto no_coincident_vertex = [&]() {
+          return ExcMessage(where + "node-to-node pairing: slave vertex at " +
+                            point_text(slave.position) +
+                            " has no coincident master vertex");
+        };
         if (hit.face == nullptr)
           {
             AssertThrow(interface.pairing != Pairing::node_to_node,
-                        ExcMessage(where +
-                                   "node-to-node pairing: slave vertex at " +
-                                   point_text(slave.position) +
-                                   " has no coincident master vertex"));
+                        no_coincident_vertex());
             continue;
           }
         const Face &face = *hit.face;
@@ -226,10 +228,7 @@ namespace knee_contact
               value = std::round(value);
         if (interface.pairing == Pairing::node_to_node)
           AssertThrow(hit.s == 0 && std::count(phi.begin(), phi.end(), 1.) == 1,
-                      ExcMessage(where +
-                                 "node-to-node pairing: slave vertex at " +
-                                 point_text(slave.position) +
-                                 " has no coincident master vertex"));
+                      no_coincident_vertex());
         if (interface.maximum_gap > 0 && hit.s > interface.maximum_gap)
           continue;
         AssertThrow(

@@ -48,8 +48,8 @@ namespace knee_contact
                std::back_inserter(hits));
     if (hits.empty())
       return std::numeric_limits<double>::infinity();
-    // Distance from the point to the box: per coordinate, how far it lies
-    // outside the box's interval.
+    // Distance from the point to the box (9.4's BoundingBox has none): per
+    // coordinate, how far it lies outside the box's interval.
     double square = 0;
     for (unsigned int d = 0; d < dim; ++d)
       {
@@ -83,17 +83,6 @@ namespace knee_contact
 
 
   template <int dim>
-  BoundingBox<dim>
-  grown_box(const std::vector<Point<dim>> &points, const double margin)
-  {
-    BoundingBox<dim> box(points);
-    box.extend(margin);
-    return box;
-  }
-
-
-
-  template <int dim>
   ContactSearch<dim>
   master_face_search(const ContactSides<dim> &sides)
   {
@@ -113,8 +102,4 @@ namespace knee_contact
   template ContactSearch<3>
   master_face_search(const ContactSides<3> &);
   template class ContactSearch<3>;
-  template BoundingBox<2>
-  grown_box(const std::vector<Point<2>> &, const double);
-  template BoundingBox<3>
-  grown_box(const std::vector<Point<3>> &, const double);
 } // namespace knee_contact

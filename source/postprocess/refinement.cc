@@ -193,12 +193,14 @@ namespace knee_contact
         const ContactSearch<dim>                           search(centres);
         std::vector<std::pair<unsigned int, unsigned int>> facing;
         for (unsigned int i = 0; i < sides[0].size(); ++i)
-          for (const unsigned int j : search.intersecting(
-                 grown_box(std::vector<Point<dim>>{sides[0][i].centre},
-                           0.5 * (sides[0][i].length + h))))
-            if (sides[0][i].centre.distance(sides[1][j].centre) <
-                0.5 * (sides[0][i].length + sides[1][j].length))
-              facing.emplace_back(i, j);
+          {
+            BoundingBox<dim> reach(std::vector<Point<dim>>{sides[0][i].centre});
+            reach.extend(0.5 * (sides[0][i].length + h));
+            for (const unsigned int j : search.intersecting(reach))
+              if (sides[0][i].centre.distance(sides[1][j].centre) <
+                  0.5 * (sides[0][i].length + sides[1][j].length))
+                facing.emplace_back(i, j);
+          }
         for (bool changed = true; changed;)
           {
             changed = false;

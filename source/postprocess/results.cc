@@ -207,9 +207,7 @@ namespace knee_contact
                 r.peak_location = pairs.points[p].position;
               }
           }
-        for (unsigned int d = 0; d < dim; ++d)
-          r.centre_of_pressure[d] +=
-            contact.lambda[p] * pairs.points[p].position[d];
+        r.centre_of_pressure += contact.lambda[p] * pairs.points[p].position;
       }
     for (InterfaceResult<dim> &r : results.interfaces)
       {

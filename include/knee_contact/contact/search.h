@@ -55,11 +55,6 @@ namespace knee_contact
     using Tree = RTree<std::pair<BoundingBox<dim>, unsigned int>>;
     Tree tree;
   };
-
-  /** The box around @p points grown by @p margin on every side. */
-  template <int dim>
-  BoundingBox<dim>
-  grown_box(const std::vector<Point<dim>> &points, const double margin);
 } // namespace knee_contact
 
 #endif
