@@ -31,6 +31,16 @@ are 3D: tetrahedra of gmsh, so each size is a new mesh of the .geo
 (h_contact divided by sqrt 2 a step, about 2.8 times the dofs) instead of a
 global refinement; the same table.
 
+Scenes "knee3d-amg" and "hertz3d-amg" measure the iterative path (CG with
+ML's AMG, Contact/Solver = iterative) on the 3D knee (h_contact 1.2) and the
+3D Hertz sphere (h_contact 0.01) at 0, 1, 2, ... global refinements of the
+tetrahedra (8 times the cells a step) up to --max-dofs: per size the
+active-set iterations, CG iterations per solve (mean and largest), AMG
+set-ups and their time, the contact solve, one linear solve by the same path
+(a new hierarchy, CG from zero to the final tolerance), their ratio, the
+peak memory per dof; and up to --direct-max-dofs the automatic choice among
+the direct paths (condensed or sparse) on the same mesh: the crossover.
+
 Scene "gait" (prm/knee_gait.prm with 11 load cases t = 0:0.1:1) measures
 load cases: per size the first case (assembly and contact solve), the
 median further case (load vector assembly, condensation, active-set loop
@@ -216,6 +226,92 @@ def adaptive_benchmark(program, args):
                   flush=True)
 
 
+AMG_SCENES = {
+    "knee3d-amg": ("prm/knee_3d.prm", {}),
+    "hertz3d-amg": ("prm/hertz_sphere_3d.prm", {}),
+}
+
+
+def amg_benchmark(program, name, args):
+    """The iterative path per global refinement, and the direct paths on
+    the same meshes while they are below --direct-max-dofs."""
+    scene, base = AMG_SCENES[name]
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="benchmark-") as work:
+        for level in range(6):
+            changes = dict(base)
+            changes[("Mesh",), "Global refinements"] = str(level)
+            changes[("Contact",), "Solver"] = "iterative"
+            changes[("Contact",), "Reference solve"] = "true"
+            r = run(program, scene, changes, work)
+            solver = r["solver"]
+            row = {
+                "dofs": r["n_dofs"], "pairs": r["n_contact_pairs"],
+                "it": r["active_set_iterations"],
+                "cg": solver["krylov_iterations"] /
+                max(solver["krylov_solves"], 1),
+                "cg_max": solver["krylov_iterations_max"],
+                "cg_one": solver.get("reference_krylov_iterations", 0),
+                "setups": solver["amg_setups"],
+                "setup": solver["amg_setup"],
+                "contact": solver["contact_solve"],
+                "one": solver.get("reference_solve", float("nan")),
+                "memory": solver["peak_memory_MB"],
+                "estimate": solver.get("estimated_iterative_MB", 0),
+                "measured": solver.get("iterative_memory_MB", 0),
+                "mesh": r["wall_time"].get("mesh", 0),
+                "output": r["wall_time"].get("output: vtu", 0),
+                "total": sum(r["wall_time"].values()),
+                "direct": float("nan"), "direct_path": "-",
+                "direct_memory": float("nan"),
+            }
+            if row["dofs"] <= args.direct_max_dofs:
+                changes[("Contact",), "Solver"] = "automatic"
+                changes[("Contact",), "Reference solve"] = "false"
+                # The automatic choice among the direct paths only: the
+                # scene asks for the cheaper direct one.
+                d = run(program, scene, dict(changes, **{
+                    (("Contact",), "Solver"): "condensed"}), work)
+                s = run(program, scene, dict(changes, **{
+                    (("Contact",), "Solver"): "sparse"}), work)
+                best = min((d, s), key=lambda x: x["solver"]["contact_solve"])
+                row["direct"] = best["solver"]["contact_solve"]
+                row["direct_path"] = best["solver"]["name"]
+                row["direct_memory"] = best["solver"]["peak_memory_MB"]
+            rows.append(row)
+            print("%s: %d dofs done" % (name, row["dofs"]), file=sys.stderr,
+                  flush=True)
+            if 8 * row["dofs"] > args.max_dofs:
+                break
+    print("\n%s (%s), Contact/Solver = iterative" % (name, scene))
+    header = ("dofs", "pairs", "it", "CG/solve", "CG max", "CG one",
+              "AMG set-ups", "set-up", "contact", "one solve", "ratio",
+              "kB/dof", "estimate MB", "measured MB", "mesh", "VTU",
+              "run", "direct (faster path)", "direct kB/dof",
+              "direct/iterative")
+    print("| " + " | ".join(header) + " |")
+    print("|" + "---|" * len(header))
+    for r in rows:
+        print("| %d | %d | %d | %.0f | %d | %d | %d | %.3g | %.3g | %.3g | "
+              "%.2f | %.2f | %.0f | %.0f | %.3g | %.3g | %.3g | %s | %s | "
+              "%s |" % (
+                  r["dofs"], r["pairs"], r["it"], r["cg"], r["cg_max"],
+                  r["cg_one"], r["setups"], r["setup"], r["contact"],
+                  r["one"], r["contact"] / r["one"],
+                  r["memory"] * 1024 / r["dofs"], r["estimate"],
+                  r["measured"], r["mesh"], r["output"], r["total"],
+                  "-" if math.isnan(r["direct"]) else
+                  "%.3g (%s)" % (r["direct"], r["direct_path"]),
+                  "-" if math.isnan(r["direct"]) else
+                  "%.2f" % (r["direct_memory"] * 1024 / r["dofs"]),
+                  "-" if math.isnan(r["direct"]) else
+                  "%.2f" % (r["direct"] / r["contact"])))
+    sizes = [r["dofs"] for r in rows]
+    print("fitted exponent (time ~ dofs^b): contact solve %.2f, one solve "
+          "%.2f" % (exponent(sizes, [r["contact"] for r in rows]),
+                    exponent(sizes, [r["one"] for r in rows])))
+
+
 def median_run(program, scene, changes, work, repeat):
     runs = [run(program, scene, changes, work) for _ in range(repeat)]
 
@@ -262,6 +358,9 @@ def main():
     parser.add_argument("program")
     parser.add_argument("--max-dofs", type=float, default=1.8e6)
     parser.add_argument("--step41-max-dofs", type=float, default=5e5)
+    parser.add_argument("--direct-max-dofs", type=float, default=3e5,
+                        help="largest mesh of the direct paths in the "
+                        "knee3d-amg and hertz3d-amg series")
     parser.add_argument("--repeat", type=int, default=1)
     parser.add_argument("--scenes", default="hertz,knee,adaptive")
     parser.add_argument("--solver", default="automatic",
@@ -276,6 +375,9 @@ def main():
             continue
         if name == "adaptive":
             adaptive_benchmark(program, args)
+            continue
+        if name in AMG_SCENES:
+            amg_benchmark(program, name, args)
             continue
         scene, base = SCENES[name]
         rows = []

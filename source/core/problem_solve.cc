@@ -283,6 +283,8 @@ namespace knee_contact
                                   system_matrix,
                                   constraints,
                                   rows_for_solver(),
+                                  rigid_modes,
+                                  active_set_solver.krylov_settings(),
                                   !guess.empty(),
                                   output_writer.test_mode() ? quiet : loop_log,
                                   solver_name,
@@ -345,14 +347,22 @@ namespace knee_contact
         if (new_matrix && active_set_solver.measure_reference() &&
             contact_pairs.tangential.empty())
           {
+            // One linear solve by the same path: CHOLMOD for the direct
+            // paths, a new hierarchy and CG from zero for the iterative one.
             Vector<double> x;
+            auto          *iterative =
+              dynamic_cast<IterativeContactSystem *>(contact_system.get());
             solver_figures["reference_solve"] =
-              reference_solve(system_matrix,
-                              system_rhs,
-                              constraints,
-                              contact_pairs.rows,
-                              contact_solution.active,
-                              x);
+              iterative ? iterative->reference_solve(contact_solution.active, x)
+                        : reference_solve(system_matrix,
+                                          system_rhs,
+                                          constraints,
+                                          contact_pairs.rows,
+                                          contact_solution.active,
+                                          x);
+            if (iterative)
+              solver_figures["reference_krylov_iterations"] =
+                iterative->statistics()["reference_krylov_iterations"];
             x -= displacement;
             solver_figures["reference_difference"] =
               x.linfty_norm() / std::max(displacement.linfty_norm(), 1e-300);

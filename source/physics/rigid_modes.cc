@@ -62,6 +62,38 @@ namespace knee_contact
 
 
 
+  template <int dim>
+  std::vector<Vector<double>>
+  RigidModes<dim>::rigid_motions() const
+  {
+    // Each body moves by its own mode about its own centre, scaled by its
+    // size, so that the vectors are of one magnitude on every body; as the
+    // bodies share no dof, each is a rigid motion of every body at once.
+    std::vector<Vector<double>> modes(n_modes,
+                                      Vector<double>(dof_position.size()));
+    for (types::global_dof_index i = 0; i < dof_position.size(); ++i)
+      {
+        const unsigned int   b = dof_body[i];
+        const unsigned int   c = dof_component[i];
+        const Tensor<1, dim> r = (dof_position[i] - centre[b]) / size[b];
+        modes[c](i)            = 1;
+        if constexpr (dim == 2)
+          modes[2](i) = c == 0 ? -r[1] : r[0];
+        else
+          for (unsigned int k = 0; k < 3; ++k)
+            if (k != c)
+              {
+                // (e_k x r)_c = epsilon_kjc r_j.
+                const unsigned int j    = 3 - k - c;
+                const double       sign = (k + 1) % 3 == j ? 1. : -1.;
+                modes[3 + k](i)         = sign * r[j];
+              }
+      }
+    return modes;
+  }
+
+
+
   void
   RigidModeCheck::check(const AffineConstraints<double> &base,
                         const std::vector<ContactRow>   &rows,

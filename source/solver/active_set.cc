@@ -52,6 +52,7 @@ namespace knee_contact
     for (const LinearSolver path : {LinearSolver::automatic,
                                     LinearSolver::condensed,
                                     LinearSolver::sparse,
+                                    LinearSolver::iterative,
                                     LinearSolver::step41})
       paths.emplace_back(solver_path_name(path), path);
     input::add_selection(
@@ -65,9 +66,22 @@ namespace knee_contact
       "with the contact unknowns last and run the loop on their dense Schur "
       "complement (cheapest where the contact unknowns are few); sparse: one "
       "CHOLMOD analysis per mesh, one numeric factorisation per active set "
-      "(memory of the sparse factor only); step-41: condense and factorise "
-      "the whole system with UMFPACK in every iteration (the first version's "
-      "path, kept for comparison).");
+      "(memory of the sparse factor only); iterative: CG preconditioned by "
+      "Trilinos ML's AMG with the rigid motions as near null space, memory "
+      "linear in the dofs (the path for large 3D meshes); step-41: condense "
+      "and factorise the whole system with UMFPACK in every iteration (the "
+      "first version's path, kept for comparison).");
+    prm.add_parameter("Krylov tolerance",
+                      krylov.tolerance,
+                      "Iterative path: each accepted solve stops at this "
+                      "residual relative to its right hand side (earlier "
+                      "iterations stop sooner: doc/performance.md).",
+                      Patterns::Double(1e-15, 1e-3));
+    prm.add_parameter("Krylov iterations",
+                      krylov.max_iterations,
+                      "Iterative path: CG iterations allowed per solve; "
+                      "more ends the run with an error.",
+                      Patterns::Integer(1));
     prm.add_parameter("Reference solve",
                       reference_solve,
                       "After the contact solve, time one linear solve of the "
@@ -388,6 +402,13 @@ namespace knee_contact
 
     std::set<std::vector<bool>> seen;
     std::vector<double>         excesses;
+    // Why the loop stops unconverged, once known (see below).
+    std::string failure;
+    // Whether the solves may stop early while the set changes, and whether
+    // one did (the iterative path).
+    bool inexact = true, had_inexact_solve = false;
+    // The first solve to 1e-4 of the load (see below).
+    system.set_accuracy(1e-4);
 
     for (unsigned int iteration = 1;; ++iteration)
       {
@@ -402,6 +423,7 @@ namespace knee_contact
                 " its load pulls it off its contact pairs");
 
         system.solve(result.active, excesses, result.lambda);
+        had_inexact_solve = had_inexact_solve || !system.last_solve_exact();
 
         // The active-set test of step-41, and the NCP residual
         // |min(lambda_p, g_p - (A x)_p)| scaled by max lambda and max |u|.
@@ -461,17 +483,46 @@ namespace knee_contact
             << std::scientific << std::setprecision(2) << result.complementarity
             << std::defaultfloat << Progress::stamp(log) << std::endl;
 
+        // An inexact solve (the iterative path while the set changes) that
+        // repeats its set is solved again to the final tolerance, from
+        // where it stopped, before the set is accepted; so is the last set
+        // of a loop that stops unconverged, so that what it reports is its
+        // set's exact solution.
+        if ((next == result.active || !failure.empty()) &&
+            !system.last_solve_exact())
+          {
+            system.set_accuracy(0);
+            continue;
+          }
+        // Whatever follows the loop (the error estimate's solves) asks for
+        // its own accuracy.
+        system.set_accuracy(0);
+        if (!failure.empty())
+          {
+            result.converged = false;
+            result.failure   = failure;
+            return result;
+          }
         if (next == result.active && result.complementarity <= tolerance)
           return result;
         if (next == result.active)
+          failure = "the active set settled but the complementarity residual "
+                    "stays above Contact/Tolerance";
+        if (failure.empty() && seen.count(next) && inexact && had_inexact_solve)
           {
-            result.converged = false;
-            result.failure   = "the active set settled but the "
-                               "complementarity residual stays above "
-                               "Contact/Tolerance";
-            return result;
+            // A set returns while the solves are inexact: the decisions
+            // of pairs near zero may have been the Krylov solver's error.
+            // From here on every solve is exact, and this set is solved
+            // again.
+            inexact = false;
+            seen.clear();
+            log << "   active set cycle at iteration " << iteration
+                << " under inexact solves: exact solves from now on"
+                << std::endl;
+            continue;
           }
-        if (seen.count(next) && safeguard && result.safeguard_from == 0)
+        if (failure.empty() && seen.count(next) && safeguard &&
+            result.safeguard_from == 0)
           {
             // Switch the safeguard on and forget the history: from here on
             // the set changes by one release at a time.
@@ -482,24 +533,34 @@ namespace knee_contact
             seen.clear();
             release_one();
           }
-        if (seen.count(next))
+        if (failure.empty() && seen.count(next))
+          failure =
+            "the active set cycles (iteration " + std::to_string(iteration) +
+            " returns to an earlier set); make the finer side the slave, "
+            "or refine the coarse side of the interface";
+        if (failure.empty() && iteration >= max_iterations)
+          failure = "no convergence in " + std::to_string(max_iterations) +
+                    " active-set iterations; raise 'Maximum active set "
+                    "iterations' or refine the contact zone";
+        if (!failure.empty())
           {
+            if (!system.last_solve_exact())
+              {
+                // One more solve of this set to the final tolerance.
+                system.set_accuracy(0);
+                continue;
+              }
             result.converged = false;
-            result.failure =
-              "the active set cycles (iteration " + std::to_string(iteration) +
-              " returns to an earlier set); make the finer side the slave, "
-              "or refine the coarse side of the interface";
+            result.failure   = failure;
             return result;
           }
-        if (iteration >= max_iterations)
-          {
-            result.converged = false;
-            result.failure =
-              "no convergence in " + std::to_string(max_iterations) +
-              " active-set iterations; raise 'Maximum active set "
-              "iterations' or refine the contact zone";
-            return result;
-          }
+        // While the set changes, the next solve needs only the accuracy
+        // that decides it: a hundredth of this complementarity residual
+        // (Eisenstat and Walker's forcing term for inexact Newton), at most
+        // 1e-4 and no less than the loop's tolerance.
+        if (inexact)
+          system.set_accuracy(
+            std::clamp(1e-2 * result.complementarity, tolerance, 1e-4));
         seen.insert(result.active);
         result.active = next;
       }

@@ -41,6 +41,8 @@ namespace knee_contact
           return "condensed";
         case SolverPath::sparse:
           return "sparse";
+        case SolverPath::iterative:
+          return "iterative";
         case SolverPath::step41:
           return "step-41";
       }
@@ -54,6 +56,8 @@ namespace knee_contact
                       const SparseMatrix<double>      &matrix,
                       const AffineConstraints<double> &base,
                       const std::vector<ContactRow>   &pairs,
+                      const RigidModeCheck            &rigid_modes,
+                      const KrylovSettings            &krylov,
                       const bool                       warm_start,
                       std::ostream                    &log,
                       std::string                     &name,
@@ -65,6 +69,38 @@ namespace knee_contact
         // is not known before its factorisation, so it is not estimated.
         name = "step-41";
         return std::make_unique<FullContactSystem>(matrix, base, pairs);
+      }
+
+    const auto iterative = [&](const std::string &reason) {
+      name = "iterative";
+      log << "   solver: iterative (" << reason << ")" << std::endl;
+      return std::make_unique<IterativeContactSystem>(
+        matrix,
+        base,
+        pairs,
+        rigid_modes.rigid_motions(),
+        rigid_modes.components(),
+        krylov);
+    };
+    if (requested == SolverPath::iterative)
+      {
+        // No direct path is analysed: the memory test is the iterative
+        // path's own.
+        std::string  limit;
+        const double available = memory::available(limit);
+        const double bytes     = IterativeContactSystem::estimated_bytes(
+          matrix.get_sparsity_pattern());
+        figures["estimated_iterative_MB"] = bytes / 1048576.;
+        figures["available_MB"]           = available / 1048576.;
+        AssertThrow(bytes <= 0.8 * available,
+                    ExcMessage("out of memory: the contact solve (iterative "
+                               "path) needs about " +
+                               megabytes(bytes) + " more, but " +
+                               megabytes(available) + " are available (" +
+                               limit +
+                               "); use fewer refinement cycles, a coarser "
+                               "mesh or a machine with more memory"));
+        return iterative("as Contact/Solver says");
       }
 
     // Sizes of the condensed path: k contact unknowns (every free dof of
@@ -155,6 +191,24 @@ namespace knee_contact
     figures["process_virtual_MB"]        = memory::process_virtual() / 1048576.;
     figures["contact_unknowns"]          = k;
 
+    // The iterative path: its memory from the pattern; its time from
+    // measured rates on this machine kind (AMD EPYC, 2 cores; the 3D
+    // knee's tetrahedra at 3.4e4 and 2.3e5 dofs, 2026-11-26): a hierarchy
+    // about 75 ns and a CG iteration (product and V-cycle) 3.2 to 4.7 ns
+    // per matrix entry; 25 to 60 iterations per active-set iteration (to
+    // 1e-4, warm started) and about 100 for the final solve to 1e-12.
+    // CHOLMOD's numeric factorisation ran at 2-5 Gflop/s on 2D meshes and
+    // 20-25 Gflop/s on the 3D knee (larger supernodes): 10 Gflop/s here.
+    const double nnz = sparsity.n_nonzero_elements();
+    const double iterative_bytes =
+      IterativeContactSystem::estimated_bytes(sparsity);
+    const double krylov_iterations = 40 * iterations + 100;
+    const double iterative_seconds =
+      1e-9 * nnz * (75 + 4.7 * krylov_iterations);
+    const double cholmod_rate         = 10e9;
+    figures["estimated_iterative_MB"] = iterative_bytes / 1048576.;
+    figures["estimated_iterative_s"]  = iterative_seconds;
+
     SolverPath  path = requested;
     std::string reason;
     if (requested == SolverPath::automatic)
@@ -173,6 +227,24 @@ namespace knee_contact
             reason += "; the condensed path's " + megabytes(condensed_bytes) +
                       " exceed the " + megabytes(available) + " available";
           }
+        const double direct_bytes =
+          path == SolverPath::condensed ? condensed_bytes : sparse_bytes;
+        const double direct_seconds =
+          std::min(condensed_flops, sparse_flops) / cholmod_rate;
+        std::ostringstream seconds;
+        seconds << std::setprecision(2) << "; about " << direct_seconds
+                << " s against " << iterative_seconds << " s iterative (AMG, "
+                << int(krylov_iterations) << " CG iterations expected)";
+        reason += seconds.str();
+        if (fits(iterative_bytes) &&
+            (!fits(direct_bytes) || iterative_seconds < direct_seconds))
+          {
+            if (!fits(direct_bytes))
+              reason += "; the direct paths' " + megabytes(direct_bytes) +
+                        " exceed the " + megabytes(available) + " available";
+            sparse.reset();
+            return iterative(reason);
+          }
       }
     else if (requested == SolverPath::condensed && !fits(condensed_bytes) &&
              fits(sparse_bytes))
@@ -184,16 +256,30 @@ namespace knee_contact
       }
     else
       reason = "as Contact/Solver says";
-    // Neither fits: name the smaller of the two needs.
+    // A direct path that does not fit: the iterative one if it does.
+    const double direct_needed =
+      path == SolverPath::condensed ? condensed_bytes : sparse_bytes;
+    if (!fits(direct_needed) && fits(iterative_bytes) &&
+        (requested != SolverPath::condensed || !fits(sparse_bytes)))
+      {
+        sparse.reset();
+        return iterative("the " + solver_path_name(path) +
+                         " path needs about " + megabytes(direct_needed) +
+                         ", more than 80 % of the " + megabytes(available) +
+                         " available (" + limit + ")");
+      }
+    // Nothing fits: name the smallest of the needs.
     if (!fits(condensed_bytes) && !fits(sparse_bytes))
       path = condensed_bytes < sparse_bytes ? SolverPath::condensed
                                             : SolverPath::sparse;
     const double needed =
       path == SolverPath::condensed ? condensed_bytes : sparse_bytes;
     AssertThrow(fits(needed),
-                ExcMessage("out of memory: the contact solve (" +
-                           solver_path_name(path) + " path) needs about " +
-                           megabytes(needed) + " more, but " +
+                ExcMessage("out of memory: the contact solve needs about " +
+                           megabytes(std::min(needed, iterative_bytes)) +
+                           " more (" + solver_path_name(path) + " path " +
+                           megabytes(needed) + ", iterative " +
+                           megabytes(iterative_bytes) + "), but " +
                            megabytes(available) + " are available (" + limit +
                            "); use fewer refinement cycles, a coarser mesh "
                            "or a machine with more memory"));

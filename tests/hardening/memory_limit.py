@@ -11,10 +11,18 @@ process's mapped size when the path is chosen (summary.json). Then:
    program keeps): the condensed path does not fit, the sparse one does;
    the run must switch to it, say so in one line, exit 0 with every check
    passing, and give the same results as the unlimited run (to 1e-10);
-2. limits from mapped size + 0.9 x the sparse path's need down in 40 MB
+2. limits from mapped size + 0.9 x the sparse path's need down in 20 MB
    steps: each run succeeds or exits 1 with one out-of-memory line and no
    result folder, and one of them must be the estimate's one-line refusal
-   naming the need and the limit.
+   naming the needs and the limit;
+3. the 3D Hertz sphere (prm/hertz_sphere_3d.prm, h_contact 0.014, 20 820
+   dofs) with Contact/Solver = sparse, where the sparse factor needs about
+   seven times the iterative path (CG with AMG, memory linear in the dofs):
+   limits from its mapped size + the sparse need / 0.8 - 10 MB down in
+   25 MB steps until a run takes the iterative path; it must say so in one line, exit 0
+   and give the unlimited run's energy to the iterative path's tolerance
+   (tests/unit/solver_paths.cc: 1e-8 relative at this contrast of 2); the
+   runs before it finish on the sparse path.
 
 Skipped (77) under AddressSanitizer, which reserves terabytes of address
 space at start.
@@ -115,15 +123,15 @@ end
     # The mapped size at the choice is not the same under every limit
     # (libraries reserve less address space when less is left: measured
     # 1 072 MB unlimited, 895 MB under a 1 132 MB limit), so the refusal is
-    # sought on a descending series of limits, 40 MB apart, from the first
+    # sought on a descending series of limits, 20 MB apart, from the first
     # run's mapped size + 0.9 x the sparse need: every run must either
     # succeed or end with exit 1 and one line saying out of memory (the
     # estimate's refusal, or an allocation refused earlier in the run),
     # never a crash, a kill or a half-written result folder, and the
     # estimate's refusal must come before the series ends.
     refusal = None
-    for step in range(12):
-        limit = int((mapped + 0.9 * sparse - 40 * step) * 1024)
+    for step in range(24):
+        limit = int((mapped + 0.9 * sparse - 20 * step) * 1024)
         code, log, refused = run("refuse", limit)
         lines = [line for line in log.splitlines()
                  if line.startswith("knee_contact: error: out of memory")]
@@ -152,6 +160,66 @@ end
         print("FAIL: no run was refused by the estimate")
     else:
         print(refusal[:150] + " ...")
+
+    # 3. The switch to the iterative path.
+    for name in ("hertz_sphere_3d.geo", "hertz_sphere_3d.prm"):
+        shutil.copy(os.path.join(root, "prm", name), work)
+    scene = open(os.path.join(work, "hertz_sphere_3d.prm")).read().replace(
+        "h_contact 0.01", "h_contact 0.014")
+    scene += """
+subsection Contact
+  set Solver = sparse
+end
+subsection Output
+  set Pictures = false
+  set Folder = %s
+end
+"""
+    code, log, free = run("sphere", None)
+    if code != 0 or free is None:
+        sys.exit("FAIL: the unlimited 3D run failed (exit %d):\n%s" %
+                 (code, log[-2000:]))
+    solver = free["solver"]
+    mapped = solver["process_virtual_MB"]
+    sparse, iterative = (solver["estimated_sparse_MB"],
+                         solver["estimated_iterative_MB"])
+    print("3D unlimited: path %s, estimates sparse %.0f MB, iterative %.0f "
+          "MB, mapped %.0f MB" % (solver["name"], sparse, iterative, mapped))
+    switched = False
+    for step in range(12):
+        limit = int((mapped + sparse / 0.8 + 100 - 25 * step) * 1024)
+        code, log, limited = run("sphere_limited", limit)
+        line = [l for l in log.splitlines()
+                if "solver: iterative (the sparse path needs about" in l]
+        errors = [l for l in log.splitlines()
+                  if l.startswith("knee_contact: error: ")]
+        path = limited["solver"]["name"] if limited else "-"
+        print("limit %d MB: exit %d, path %s%s" % (
+            limit // 1024, code, path,
+            (", " + errors[0][21:120]) if errors else ""))
+        left = os.path.exists(os.path.join(work, "sphere_limited"))
+        shutil.rmtree(os.path.join(work, "sphere_limited"), ignore_errors=True)
+        if code == 1 and len(errors) == 1 and "out of memory" in errors[0] \
+                and not left:
+            continue
+        if code != 0 or path == "-":
+            print("FAIL: the run neither finished nor was refused in one "
+                  "line:\n" + log[-1000:])
+            ok = False
+            break
+        if path == "iterative":
+            same = abs(limited["energy"] - free["energy"]) <= \
+                1e-8 * abs(free["energy"])
+            print("  %s; energy %.12g / %.12g: %s" % (
+                line[0].strip()[:110] if line else "NO SWITCH LINE",
+                free["energy"], limited["energy"],
+                "same" if same else "DIFFERENT"))
+            ok = ok and bool(line) and same
+            switched = True
+            break
+    if not switched:
+        ok = False
+        print("FAIL: no run switched to the iterative path")
     print("PASS" if ok else "FAIL")
     sys.exit(0 if ok else 1)
 finally:

@@ -1,5 +1,6 @@
-// The condensed, sparse and automatic solver paths against the step-41 path
-// (the first version's solver, an independent computation of the same QP: it
+// The condensed, sparse, automatic and iterative solver paths against the
+// step-41 path (the first version's solver, an independent computation of the
+// same QP: it
 // factorises the whole system with UMFPACK in every iteration instead of
 // CHOLMOD once with a Schur complement, or CHOLMOD once per active set on a
 // fixed analysis): on every contact test scene, among them floating bodies
@@ -12,6 +13,14 @@
 // direct solve grows with r: there the tolerance is 1e-12 r if that is
 // larger (measured: knee_small, r = 338: 1.4e-10; knee_frontal_small,
 // r = 588: 1.0e-10; contrast_1e6: 1.3e-9).
+// The iterative path (CG with AMG) solves each accepted set to a residual of
+// Contact/Krylov tolerance = 1e-12 of its right hand side; its error is that
+// times the condition number of the condensed system, which grows with the
+// contrast and the mesh: it must end with the same exit and active set, and
+// displacements and multipliers to 1e-8 relative, or 1e-10 r if larger
+// (measured 2026-11-26: at most 1.6e-11 on the scenes of contrast below
+// 1 200, 6.1e-10 on contrast_1e6); where the loop cannot converge, the same
+// exit.
 
 #include <knee_contact/core/problem.h>
 
@@ -74,14 +83,24 @@ namespace
    * round-off (seen once: knee_small, 11 iterations either way).
    */
   bool
-  agrees(const Run &reference, const Run &other, std::string &why)
+  agrees(const Run   &reference,
+         const Run   &other,
+         std::string &why,
+         const bool   iterative)
   {
     bool ok = reference.status == other.status &&
               reference.error == other.error &&
               reference.x.size() == other.x.size() &&
               reference.contact.active == other.contact.active;
+    // A loop that cannot converge (the unsafeguarded cycle) stops on the
+    // iterative path too, but where it stops depends on the path: its
+    // inexact early solves meet the cycle at another set and then solve
+    // exactly (measured: iteration 11 with 4 active pairs against 8 with
+    // 10).
+    if (iterative && reference.status == 3 && other.status == 3)
+      ok = reference.error == other.error;
     double dx = 0, dl = 0, l_scale = 1e-300;
-    if (ok)
+    if (ok && !(iterative && reference.status == 3))
       {
         Vector<double> difference = other.x;
         difference -= reference.x;
@@ -95,8 +114,10 @@ namespace
                                    other.contact.lambda[p]));
           }
         dl /= l_scale;
-        const double tolerance = std::max(1e-10, 1e-12 * reference.contrast);
-        ok                     = dx <= tolerance && dl <= tolerance;
+        const double tolerance =
+          iterative ? std::max(1e-8, 1e-10 * reference.contrast)
+                    : std::max(1e-10, 1e-12 * reference.contrast);
+        ok = dx <= tolerance && dl <= tolerance;
       }
     std::ostringstream out;
     out << "exit " << reference.status << " / " << other.status
@@ -123,10 +144,12 @@ namespace
                                        : std::string("refused"))
               << ", " << n_active << " active pairs";
     bool all = true;
-    for (const Path path : {Path::condensed, Path::sparse, Path::automatic})
+    for (const Path path :
+         {Path::condensed, Path::sparse, Path::automatic, Path::iterative})
       {
         std::string why;
-        const bool  ok = agrees(step41, run<dim>(scene, path), why);
+        const bool  ok =
+          agrees(step41, run<dim>(scene, path), why, path == Path::iterative);
         std::cout << ", " << solver_path_name(path) << " "
                   << (ok ? "same" : "DIFFERENT");
         if (!ok)

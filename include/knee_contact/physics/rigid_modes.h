@@ -4,6 +4,7 @@
 #include <knee_contact/solver/contact_row.h>
 
 #include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/vector.h>
 
 #include <deal.II/dofs/dof_handler.h>
 
@@ -38,6 +39,19 @@ namespace knee_contact
      * constraints leave one. @p context ends the message (what the user can
      * do).
      */
+    /**
+     * The rigid motions of the whole mesh as dof vectors: the translations
+     * along the axes, then the rotations about the axes through the mesh's
+     * centre scaled by its size (three in 2D, six in 3D); every body's
+     * stiffness matrix maps them to zero. The near null space of AMG.
+     */
+    virtual std::vector<Vector<double>>
+    rigid_motions() const = 0;
+
+    /** Dofs per vertex (the dimension). */
+    virtual unsigned int
+    components() const = 0;
+
     void
     check(const AffineConstraints<double> &base,
           const std::vector<ContactRow>   &rows,
@@ -68,6 +82,15 @@ namespace knee_contact
     free_motion(const AffineConstraints<double> &base,
                 const std::vector<ContactRow>   &rows,
                 const std::vector<bool>         &active) const override;
+
+    std::vector<Vector<double>>
+    rigid_motions() const override;
+
+    unsigned int
+    components() const override
+    {
+      return dim;
+    }
 
     /** Modes per body: translations, then rotations. */
     static constexpr unsigned int n_modes = dim * (dim + 1) / 2;

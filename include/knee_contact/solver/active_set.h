@@ -148,6 +148,13 @@ namespace knee_contact
       return reference_solve;
     }
 
+    /** The iterative path's settings. */
+    const KrylovSettings &
+    krylov_settings() const
+    {
+      return krylov;
+    }
+
     /** Override the scene's Contact/Solver (tests compare the two). */
     void
     set_linear_solver(const LinearSolver linear_solver)
@@ -274,12 +281,13 @@ namespace knee_contact
   private:
     unsigned int max_iterations = 50;
     /** Active set constant as the scene gives it, in units of E_max. */
-    double       c_relative      = 100;
-    double       c               = 0;
-    double       tolerance       = 1e-10;
-    bool         safeguard       = true;
-    LinearSolver solver          = LinearSolver::automatic;
-    bool         reference_solve = false;
+    double         c_relative      = 100;
+    double         c               = 0;
+    double         tolerance       = 1e-10;
+    bool           safeguard       = true;
+    LinearSolver   solver          = LinearSolver::automatic;
+    bool           reference_solve = false;
+    KrylovSettings krylov;
   };
 } // namespace knee_contact
 

@@ -1,6 +1,7 @@
 #ifndef knee_contact_contact_system_h
 #define knee_contact_contact_system_h
 
+#include <knee_contact/physics/rigid_modes.h>
 #include <knee_contact/solver/contact_row.h>
 
 #include <deal.II/lac/affine_constraints.h>
@@ -65,6 +66,25 @@ namespace knee_contact
     virtual void
     gaps_changed()
     {}
+
+    /**
+     * Inexact solves (the iterative path): the following solves may stop
+     * at a residual of @p relative times the right hand side's norm (the
+     * loop asks for little while the active set still changes); 0: solve
+     * to the path's final tolerance. Direct paths are always exact.
+     */
+    virtual void
+    set_accuracy(const double relative)
+    {
+      (void)relative;
+    }
+
+    /** Whether the last solve met the final tolerance. */
+    virtual bool
+    last_solve_exact() const
+    {
+      return true;
+    }
 
     /**
      * max |x_i| of the last solve over the contact unknowns (the free dofs
@@ -293,6 +313,97 @@ namespace knee_contact
 
 
   /**
+   * The settings of the iterative path (Contact/Krylov ...).
+   */
+  struct KrylovSettings
+  {
+    /** Final relative residual |b - K y| / |b| of each solve. */
+    double tolerance = 1e-12;
+    /** CG iterations allowed per solve. */
+    unsigned int max_iterations = 1000;
+  };
+
+
+
+  /**
+   * The iterative path (as step-42's, for bodies in contact with each
+   * other): each iteration's system, C with the Gamma_u/Gamma_o lines and
+   * the active rows condensed (each active row eliminates its dof, the
+   * master entries carried by an AffineConstraints), is solved by CG,
+   * preconditioned by Trilinos ML's smoothed aggregation AMG with the rigid
+   * motions as near null space. The operator is applied as T^T C T on the
+   * stiffness matrix (no copy of it per active set); the AMG hierarchy is
+   * built on the condensed matrix of one active set and kept while the
+   * extra CG iterations it costs on later sets stay below the price of a
+   * new hierarchy; each solve starts from the previous solution and stops
+   * at the accuracy the loop asks for. Memory grows linearly with the dofs:
+   * the condensed matrix in Trilinos' format, the hierarchy (about a third
+   * of it) and a few vectors.
+   */
+  class IterativeContactSystem : public ContactSystem
+  {
+  public:
+    /**
+     * @p modes: the rigid motions of the mesh (RigidModeCheck::
+     * rigid_motions()), AMG's near null space; @p components: the dofs per
+     * vertex (the block size of the aggregation).
+     */
+    IterativeContactSystem(const SparseMatrix<double>        &matrix,
+                           const AffineConstraints<double>   &base,
+                           const std::vector<ContactRow>     &pairs,
+                           const std::vector<Vector<double>> &modes,
+                           const unsigned int                 components,
+                           const KrylovSettings              &settings);
+    ~IterativeContactSystem() override;
+
+    void
+    set_rhs(const Vector<double> &rhs) override;
+
+    void
+    solve(const std::vector<bool> &active,
+          std::vector<double>     &excess,
+          std::vector<double>     &lambda) override;
+
+    void
+    set_accuracy(const double relative) override;
+
+    bool
+    last_solve_exact() const override;
+
+    double
+    displacement_scale() const override;
+
+    void
+    solution(Vector<double> &x) override;
+
+    std::map<std::string, double>
+    statistics() const override;
+
+    /**
+     * The benchmark's reference for this path: one linear solve with
+     * @p active held, from a new hierarchy and a zero start to the final
+     * tolerance, in @p x; returns its wall time (set-up included). The
+     * hierarchy of the loop is replaced (no second one is held).
+     */
+    double
+    reference_solve(const std::vector<bool> &active, Vector<double> &x);
+
+    /**
+     * Peak memory [bytes] the path adds to the stiffness matrix, from the
+     * pattern: the condensed copy while it is handed over, Trilinos' matrix,
+     * the hierarchy and the Krylov vectors (measured: doc/performance.md).
+     */
+    static double
+    estimated_bytes(const SparsityPattern &pattern);
+
+  private:
+    class Implementation;
+    std::unique_ptr<Implementation> implementation;
+  };
+
+
+
+  /**
    * How the active-set loop's linear algebra is done (Contact/Solver).
    */
   enum class SolverPath
@@ -300,10 +411,11 @@ namespace knee_contact
     automatic,
     condensed,
     sparse,
+    iterative,
     step41
   };
 
-  /** "automatic", "condensed", "sparse", "step-41". */
+  /** "automatic", "condensed", "sparse", "iterative", "step-41". */
   std::string
   solver_path_name(const SolverPath path);
 
@@ -325,6 +437,8 @@ namespace knee_contact
                       const SparseMatrix<double>      &matrix,
                       const AffineConstraints<double> &base,
                       const std::vector<ContactRow>   &pairs,
+                      const RigidModeCheck            &rigid_modes,
+                      const KrylovSettings            &krylov,
                       const bool                       warm_start,
                       std::ostream                    &log,
                       std::string                     &name,
