@@ -270,10 +270,11 @@ def amg_benchmark(program, name, args):
                 changes[("Contact",), "Reference solve"] = "false"
                 # The automatic choice among the direct paths only: the
                 # scene asks for the cheaper direct one.
-                d = run(program, scene, dict(changes, **{
-                    (("Contact",), "Solver"): "condensed"}), work)
-                s = run(program, scene, dict(changes, **{
-                    (("Contact",), "Solver"): "sparse"}), work)
+                direct = []
+                for path in ("condensed", "sparse"):
+                    changes[("Contact",), "Solver"] = path
+                    direct.append(run(program, scene, changes, work))
+                d, s = direct
                 best = min((d, s), key=lambda x: x["solver"]["contact_solve"])
                 row["direct"] = best["solver"]["contact_solve"]
                 row["direct_path"] = best["solver"]["name"]

@@ -195,14 +195,14 @@ namespace knee_contact
     // measured rates on this machine kind (AMD EPYC, 2 cores; the 3D
     // knee's tetrahedra at 3.4e4 and 2.3e5 dofs, 2026-11-26): a hierarchy
     // about 75 ns and a CG iteration (product and V-cycle) 3.2 to 4.7 ns
-    // per matrix entry; 25 to 60 iterations per active-set iteration (to
-    // 1e-4, warm started) and about 100 for the final solve to 1e-12.
+    // per matrix entry; 25 to 40 iterations per active-set iteration (to
+    // 1e-2, warm started) and 100 to 160 for the final solve to 1e-12.
     // CHOLMOD's numeric factorisation ran at 2-5 Gflop/s on 2D meshes and
     // 20-25 Gflop/s on the 3D knee (larger supernodes): 10 Gflop/s here.
     const double nnz = sparsity.n_nonzero_elements();
     const double iterative_bytes =
       IterativeContactSystem::estimated_bytes(sparsity);
-    const double krylov_iterations = 40 * iterations + 100;
+    const double krylov_iterations = 30 * iterations + 150;
     const double iterative_seconds =
       1e-9 * nnz * (75 + 4.7 * krylov_iterations);
     const double cholmod_rate         = 10e9;

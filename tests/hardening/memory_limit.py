@@ -18,11 +18,14 @@ process's mapped size when the path is chosen (summary.json). Then:
 3. the 3D Hertz sphere (prm/hertz_sphere_3d.prm, h_contact 0.014, 20 820
    dofs) with Contact/Solver = sparse, where the sparse factor needs about
    seven times the iterative path (CG with AMG, memory linear in the dofs):
-   limits from its mapped size + the sparse need / 0.8 - 10 MB down in
-   25 MB steps until a run takes the iterative path; it must say so in one line, exit 0
-   and give the unlimited run's energy to the iterative path's tolerance
-   (tests/unit/solver_paths.cc: 1e-8 relative at this contrast of 2); the
-   runs before it finish on the sparse path.
+   limits from its mapped size + the sparse need / 0.8 + 100 MB down in
+   25 MB steps until a run takes the iterative path; it must say so in one
+   line, exit 0, give the unlimited run's energy to the iterative path's
+   tolerance (tests/unit/solver_paths.cc: 1e-8 relative at this contrast of
+   2), and its memory estimate must be within 2x of the resident memory it
+   added by its first solve; the runs before it finish on the sparse path
+   or are refused in one out-of-memory line (the mesh's early estimate is
+   cruder than the solver's).
 
 Skipped (77) under AddressSanitizer, which reserves terabytes of address
 space at start.
@@ -210,6 +213,14 @@ end
         if path == "iterative":
             same = abs(limited["energy"] - free["energy"]) <= \
                 1e-8 * abs(free["energy"])
+            # The path's estimate against the resident memory it added by
+            # its first solve: within 2x either way.
+            estimate = limited["solver"]["estimated_iterative_MB"]
+            measured = limited["solver"]["iterative_memory_MB"]
+            close = 0.5 <= measured / estimate <= 2
+            print("  iterative path: estimated %.1f MB, measured %.1f MB: %s"
+                  % (estimate, measured, "within 2x" if close else "NOT"))
+            ok = ok and close
             print("  %s; energy %.12g / %.12g: %s" % (
                 line[0].strip()[:110] if line else "NO SWITCH LINE",
                 free["energy"], limited["energy"],
