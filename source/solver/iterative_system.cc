@@ -60,35 +60,6 @@ namespace knee_contact
     }
 
     /**
-     * T y: the constrained entries from the closed lines' free entries,
-     * without the inhomogeneities.
-     */
-    void
-    distribute_homogeneous(const AffineConstraints<double> &constraints,
-                           Vector<double>                  &v)
-    {
-      for (const auto &line : constraints.get_lines())
-        {
-          double value = 0;
-          for (const auto &[j, c] : line.entries)
-            value += c * v(j);
-          v(line.index) = value;
-        }
-    }
-
-    /** T^T v (the constrained entries then zero). */
-    void
-    condense_homogeneous(const AffineConstraints<double> &constraints,
-                         Vector<double>                  &v)
-    {
-      for (const auto &line : constraints.get_lines())
-        for (const auto &[j, c] : line.entries)
-          v(j) += c * v(line.index);
-      for (const auto &line : constraints.get_lines())
-        v(line.index) = 0;
-    }
-
-    /**
      * The condensed operator of one active set, T^T C T on the free dofs
      * and C's diagonal on the constrained ones (whose right hand side is
      * zero), applied with the stiffness matrix itself: no copy per set.
@@ -107,9 +78,9 @@ namespace knee_contact
       vmult(Vector<double> &dst, const Vector<double> &src) const
       {
         spread = src;
-        distribute_homogeneous(constraints, spread);
+        sparse_cholesky::distribute_homogeneous(constraints, spread);
         matrix.vmult(dst, spread);
-        condense_homogeneous(constraints, dst);
+        sparse_cholesky::condense_homogeneous(constraints, dst);
         for (const auto &line : constraints.get_lines())
           dst(line.index) = matrix.diag_element(line.index) * src(line.index);
         ++n_products;

@@ -75,6 +75,34 @@ namespace knee_contact
 
 
 
+    void
+    condense_homogeneous(const AffineConstraints<double> &constraints,
+                         Vector<double>                  &v)
+    {
+      for (const auto &line : constraints.get_lines())
+        for (const auto &[j, c] : line.entries)
+          v(j) += c * v(line.index);
+      for (const auto &line : constraints.get_lines())
+        v(line.index) = 0;
+    }
+
+
+
+    void
+    distribute_homogeneous(const AffineConstraints<double> &constraints,
+                           Vector<double>                  &v)
+    {
+      for (const auto &line : constraints.get_lines())
+        {
+          double value = 0;
+          for (const auto &[j, c] : line.entries)
+            value += c * v(j);
+          v(line.index) = value;
+        }
+    }
+
+
+
     std::vector<int>
     fill_reducing_ordering(const CsrMatrix                            &a,
                            const std::vector<types::global_dof_index> &last)

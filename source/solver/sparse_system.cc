@@ -64,31 +64,6 @@ namespace knee_contact
       return SparseVector(sum.begin(), sum.end());
     }
 
-    /** T^T v: v condensed under closed lines, zero inhomogeneity. */
-    void
-    condense_homogeneous(const AffineConstraints<double> &constraints,
-                         Vector<double>                  &v)
-    {
-      for (const auto &line : constraints.get_lines())
-        for (const auto &[j, c] : line.entries)
-          v(j) += c * v(line.index);
-      for (const auto &line : constraints.get_lines())
-        v(line.index) = 0;
-    }
-
-    /** T y: the constrained entries from closed lines, no inhomogeneity. */
-    void
-    distribute_homogeneous(const AffineConstraints<double> &constraints,
-                           Vector<double>                  &v)
-    {
-      for (const auto &line : constraints.get_lines())
-        {
-          double value = 0;
-          for (const auto &[j, c] : line.entries)
-            value += c * v(j);
-          v(line.index) = value;
-        }
-    }
   } // namespace
 
 
@@ -184,11 +159,11 @@ namespace knee_contact
   void
   SparseContactSystem::Implementation::solve_base_homogeneous(Vector<double> &b)
   {
-    condense_homogeneous(constraints, b);
+    sparse_cholesky::condense_homogeneous(constraints, b);
     std::vector<double> z(b.begin(), b.end());
     cholesky.solve(CHOLMOD_A, z);
     std::copy(z.begin(), z.end(), b.begin());
-    distribute_homogeneous(constraints, b);
+    sparse_cholesky::distribute_homogeneous(constraints, b);
   }
 
 

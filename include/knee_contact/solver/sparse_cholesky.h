@@ -68,6 +68,24 @@ namespace knee_contact
              const AffineConstraints<double> &constraints);
 
     /**
+     * T^T v for closed lines, zero inhomogeneity: each constrained entry
+     * added to the free entries its line refers to, then zeroed
+     * (AffineConstraints::condense() of a vector without the
+     * inhomogeneities, on a vector it may not own).
+     */
+    void
+    condense_homogeneous(const AffineConstraints<double> &constraints,
+                         Vector<double>                  &v);
+
+    /**
+     * T y for closed lines: each constrained entry from the free entries
+     * its line refers to, without the inhomogeneity.
+     */
+    void
+    distribute_homogeneous(const AffineConstraints<double> &constraints,
+                           Vector<double>                  &v);
+
+    /**
      * A fill-reducing ordering: METIS nested dissection of the graph of
      * mesh vertices (dofs with identical rows, the components of a vertex,
      * are ordered together, which makes METIS several times faster than on
