@@ -11,8 +11,12 @@ cd "$(dirname "$0")"
 # the reference BLAS; nlohmann-json writes summary.json with real numbers;
 # the condensed contact solver calls CHOLMOD (libsuitesparse-dev) and METIS;
 # zlib inflates compressed VTU meshes; meshio and VTK 9 (Python) write the
-# mesh files of other programs that the format tests read.
+# mesh files of other programs that the format tests read. The iterative
+# solver path calls Trilinos ML (libtrilinos-ml-dev) and initialises MPI
+# itself (mpi-default-dev); libdeal.ii-dev brings both, named here because
+# the code uses them directly.
 packages="cmake make g++ libdeal.ii-dev numdiff perl openmpi-bin gmsh
+          libtrilinos-ml-dev mpi-default-dev
           libopenblas0-pthread nlohmann-json3-dev python3-matplotlib
           libsuitesparse-dev libmetis-dev zlib1g-dev python3-meshio
           python3-vtk9"
