@@ -84,16 +84,24 @@ end
         return (done.returncode, done.stdout,
                 json.load(open(summary)) if os.path.exists(summary) else None)
 
-    code, log, free = run("unlimited")
-    if code != 0 or free is None:
-        sys.exit("FAIL: the unlimited run failed (exit %d):\n%s" %
-                 (code, log[-2000:]))
-    solver = free["solver"]
-    mapped = solver["process_virtual_MB"]
-    sparse, condensed = (solver["estimated_sparse_MB"],
-                         solver["estimated_condensed_MB"])
-    print("unlimited: path %s, estimates sparse %.0f MB, condensed %.0f MB, "
-          "mapped %.0f MB" % (solver["name"], sparse, condensed, mapped))
+    def unlimited(name, other):
+        """A run without a limit: its summary, mapped size at the choice,
+        and the sparse and the @p other path's estimates."""
+        code, log, free = run(name)
+        if code != 0 or free is None:
+            sys.exit("FAIL: the unlimited run %s failed (exit %d):\n%s" %
+                     (name, code, log[-2000:]))
+        solver = free["solver"]
+        mapped = solver["process_virtual_MB"]
+        sparse = solver["estimated_sparse_MB"]
+        estimate = solver["estimated_%s_MB" % other]
+        print("%s: path %s, estimates sparse %.0f MB, %s %.0f MB, mapped "
+              "%.0f MB" % (name, solver["name"], sparse, other, estimate,
+                           mapped))
+        return free, solver, mapped, sparse, estimate
+
+    free, solver, mapped, sparse, condensed = unlimited("unlimited",
+                                                        "condensed")
     if solver["name"] != "condensed" or not condensed > 2 * sparse:
         sys.exit("FAIL: the scene no longer makes the condensed path the "
                  "dearer one by 2x; choose a larger one")
@@ -178,16 +186,8 @@ subsection Output
   set Folder = %s
 end
 """
-    code, log, free = run("sphere", None)
-    if code != 0 or free is None:
-        sys.exit("FAIL: the unlimited 3D run failed (exit %d):\n%s" %
-                 (code, log[-2000:]))
-    solver = free["solver"]
-    mapped = solver["process_virtual_MB"]
-    sparse, iterative = (solver["estimated_sparse_MB"],
-                         solver["estimated_iterative_MB"])
-    print("3D unlimited: path %s, estimates sparse %.0f MB, iterative %.0f "
-          "MB, mapped %.0f MB" % (solver["name"], sparse, iterative, mapped))
+    free, solver, mapped, sparse, iterative = unlimited("sphere",
+                                                        "iterative")
     switched = False
     for step in range(12):
         limit = int((mapped + sparse / 0.8 + 100 - 25 * step) * 1024)
