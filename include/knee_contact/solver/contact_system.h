@@ -337,8 +337,8 @@ namespace knee_contact
    * extra CG iterations it costs on later sets stay below the price of a
    * new hierarchy; each solve starts from the previous solution and stops
    * at the accuracy the loop asks for. Memory grows linearly with the dofs:
-   * the condensed matrix in Trilinos' format, the hierarchy (about a third
-   * of it) and a few vectors.
+   * the condensed matrix in Trilinos' format, the hierarchy (about 0.8 of
+   * it with plain aggregation) and a few vectors.
    */
   class IterativeContactSystem : public ContactSystem
   {
