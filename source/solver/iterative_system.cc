@@ -288,11 +288,20 @@ namespace knee_contact
     const double b_norm          = std::max(b.l2_norm(), 1e-300);
 
     iterative::CondensedOperator operation(d.matrix, d.constraints);
-    SolverControl                control(d.settings.max_iterations,
-                          target_relative * b_norm,
-                          false,
-                          false);
-    SolverCG<Vector<double>>     cg(control);
+    // An inexact solve must still resolve what the new set changed: its
+    // residual falls at least a hundredfold from the warm start's.
+    // Without this a start already below the loose target took no
+    // iteration, the loop decided on the old set's solution and added
+    // back the pairs it had just released (measured: the Hertz sphere at
+    // 3.4e5 dofs alternated for 20 iterations).
+    Vector<double> start_residual(b.size());
+    operation.vmult(start_residual, y);
+    start_residual.sadd(-1., 1., b);
+    const double  target = std::max(d.settings.tolerance * b_norm,
+                                   std::min(target_relative * b_norm,
+                                            1e-2 * start_residual.l2_norm()));
+    SolverControl control(d.settings.max_iterations, target, false, false);
+    SolverCG<Vector<double>> cg(control);
     clock.restart();
     try
       {
@@ -305,7 +314,7 @@ namespace knee_contact
                 << "in " << failure.last_step
                 << " iterations (Contact/Krylov iterations): residual "
                 << failure.last_residual / b_norm << " of the target "
-                << target_relative
+                << target / b_norm
                 << " relative to the load; raise the limit, or take "
                    "Contact/Solver = sparse where the factor fits";
         AssertThrow(false, ExcMessage(message.str()));
