@@ -145,9 +145,16 @@ namespace knee_contact
     // Figures.
     double       resident_at_start = 0, measured_MB = 0;
     unsigned int reference_iterations = 0;
-    double       setup = 0, krylov = 0, condensation = 0, time_per_product = 0;
-    unsigned int n_setups = 0, n_solves = 0, n_iterations = 0,
-                 max_iterations = 0, last_iterations = 0;
+    double       condensation = 0, time_per_product = 0;
+    unsigned int last_iterations = 0;
+    /** The loop's totals for statistics() (the reference solve keeps them
+     * as they were). */
+    struct Totals
+    {
+      double       setup = 0, krylov = 0;
+      unsigned int n_setups = 0, n_solves = 0, n_iterations = 0,
+                   max_iterations = 0;
+    } totals;
 
     void
     build_amg();
@@ -202,8 +209,8 @@ namespace knee_contact
     amg.clear();
     amg.initialize(amg_matrix, list);
     has_amg = true;
-    ++n_setups;
-    setup += clock.wall_time();
+    ++totals.n_setups;
+    totals.setup += clock.wall_time();
   }
 
 
@@ -273,7 +280,7 @@ namespace knee_contact
     const bool stale = d.has_amg && d.time_per_product > 0 &&
                        (d.last_iterations - d.last_decades * d.rate_at_build) *
                            d.time_per_product >
-                         d.setup / d.n_setups;
+                         d.totals.setup / d.totals.n_setups;
     const bool fresh = !d.has_amg || stale;
     if (fresh)
       d.build_amg();
@@ -320,7 +327,7 @@ namespace knee_contact
         AssertThrow(false, ExcMessage(message.str()));
       }
     const double time = clock.wall_time();
-    d.krylov += time;
+    d.totals.krylov += time;
     d.time_per_product = time / std::max<unsigned int>(1, operation.n_products);
     d.last_iterations  = control.last_step();
     d.last_decades =
@@ -330,15 +337,16 @@ namespace knee_contact
     d.last_decades = std::max(d.last_decades, 0.5);
     if (fresh)
       d.rate_at_build = d.last_iterations / d.last_decades;
-    d.n_iterations += d.last_iterations;
-    d.max_iterations = std::max(d.max_iterations, d.last_iterations);
-    ++d.n_solves;
+    d.totals.n_iterations += d.last_iterations;
+    d.totals.max_iterations =
+      std::max(d.totals.max_iterations, d.last_iterations);
+    ++d.totals.n_solves;
 
     d.x = y;
     d.constraints.distribute(d.x);
     // What the path holds once its hierarchy, vectors and right hand
     // side exist: the figure its estimate is checked against.
-    if (d.n_solves == 1)
+    if (d.totals.n_solves == 1)
       d.measured_MB = iterative::resident_MB() - d.resident_at_start;
     ActiveSetSolver::excess_and_multipliers(
       d.matrix, *d.rhs, d.x, d.base, d.pairs, active, excess, lambda);
@@ -353,14 +361,9 @@ namespace knee_contact
     Implementation &d = *implementation;
     // Keep the loop's state (its solution and figures); only the
     // hierarchy is new.
-    const Vector<double> kept    = d.x;
-    const double         was     = d.accuracy;
-    const unsigned int   setups  = d.n_setups;
-    const double         setup   = d.setup;
-    const double         krylov  = d.krylov;
-    const unsigned int   solves  = d.n_solves;
-    const unsigned int   total   = d.n_iterations;
-    const unsigned int   largest = d.max_iterations;
+    const Vector<double> kept        = d.x;
+    const double         was         = d.accuracy;
+    const auto           kept_totals = d.totals;
     Timer                clock;
     d.x        = 0;
     d.has_amg  = false;
@@ -372,12 +375,7 @@ namespace knee_contact
     x                      = d.x;
     d.x                    = kept;
     d.accuracy             = was;
-    d.n_setups             = setups;
-    d.setup                = setup;
-    d.krylov               = krylov;
-    d.n_solves             = solves;
-    d.n_iterations         = total;
-    d.max_iterations       = largest;
+    d.totals               = kept_totals;
     return time;
   }
 
@@ -404,12 +402,12 @@ namespace knee_contact
   IterativeContactSystem::statistics() const
   {
     const Implementation &d = *implementation;
-    return {{"amg_setups", d.n_setups},
-            {"amg_setup", d.setup},
-            {"krylov_solves", d.n_solves},
-            {"krylov_iterations", d.n_iterations},
-            {"krylov_iterations_max", d.max_iterations},
-            {"krylov_time", d.krylov},
+    return {{"amg_setups", d.totals.n_setups},
+            {"amg_setup", d.totals.setup},
+            {"krylov_solves", d.totals.n_solves},
+            {"krylov_iterations", d.totals.n_iterations},
+            {"krylov_iterations_max", d.totals.max_iterations},
+            {"krylov_time", d.totals.krylov},
             {"condensation", d.condensation},
             {"iterative_memory_MB", d.measured_MB},
             {"reference_krylov_iterations", d.reference_iterations}};
