@@ -1,3 +1,4 @@
+#include <knee_contact/core/interruption.h>
 #include <knee_contact/solver/active_set.h>
 #include <knee_contact/solver/contact_system.h>
 #include <knee_contact/solver/sparse_cholesky.h>
@@ -17,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <sstream>
 
 namespace knee_contact
@@ -26,6 +28,15 @@ namespace knee_contact
     /**
      * Trilinos' Epetra objects need MPI; a serial run initialises it only
      * when this path is taken (and finalises it at exit).
+     *
+     * A process not started by mpirun is an Open MPI "singleton". By
+     * default it forks a daemon (orted) and keeps a session folder under
+     * TMPDIR (ompi.<host>.<uid>/jf.<n>) that only MPI_Finalize removes: a
+     * run stopped by a signal, whose handler must _exit, left one folder
+     * per run in /tmp (measured). So a singleton runs isolated (no daemon)
+     * with its session folder inside a private folder of its own, which
+     * the interruption handler removes on a signal and the exit handler
+     * after MPI_Finalize. Only a SIGKILL can leave it.
      */
     void
     ensure_mpi()
@@ -34,12 +45,31 @@ namespace knee_contact
       MPI_Initialized(&initialised);
       if (initialised)
         return;
-      // A process not started by mpirun talks to itself only: Open MPI's
-      // shared-memory and network transports would map memory and plugins
-      // (and fail under an address-space limit, measured), so only its
-      // "self" transport is loaded unless the user chose otherwise.
+      static std::string session_folder;
       if (std::getenv("OMPI_COMM_WORLD_SIZE") == nullptr)
-        setenv("OMPI_MCA_btl", "self", 0);
+        {
+          // Open MPI's shared-memory and network transports would map
+          // memory and plugins (and fail under an address-space limit,
+          // measured), so only its "self" transport is loaded unless the
+          // user chose otherwise.
+          setenv("OMPI_MCA_btl", "self", 0);
+          setenv("OMPI_MCA_ess_singleton_isolated", "1", 0);
+          if (std::getenv("OMPI_MCA_orte_tmpdir_base") == nullptr)
+            {
+              const char *tmpdir = std::getenv("TMPDIR");
+              std::string pattern =
+                (tmpdir != nullptr && tmpdir[0] == '/' ? tmpdir : "/tmp");
+              pattern += "/knee_contact-mpi-XXXXXX";
+              if (mkdtemp(pattern.data()) != nullptr)
+                {
+                  session_folder = pattern;
+                  interruption::register_folder(session_folder);
+                  setenv("OMPI_MCA_orte_tmpdir_base",
+                         session_folder.c_str(),
+                         1);
+                }
+            }
+        }
       int provided = 0;
       MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided);
       std::atexit([]() {
@@ -47,6 +77,12 @@ namespace knee_contact
         MPI_Finalized(&finalised);
         if (!finalised)
           MPI_Finalize();
+        if (!session_folder.empty())
+          {
+            std::error_code ignored;
+            std::filesystem::remove_all(session_folder, ignored);
+            interruption::unregister_folder(session_folder);
+          }
       });
     }
 

@@ -73,6 +73,25 @@ for phase in in_solve writing_output drawing; do
   done
 done
 
+# The iterative path initialises MPI, whose singleton keeps a session
+# folder under TMPDIR: interrupted once MPI is up (in the solve or just
+# after it), it must leave nothing there either.
+cp scene.prm iterative.prm
+printf 'subsection Contact\n  set Solver = iterative\nend\n' >>iterative.prm
+"$program" iterative.prm >run.log 2>run.err &
+pid=$!
+wait_for 60 in_solve || fail "iterative: the solve never started"
+kill -TERM $pid
+wait $pid
+code=$?
+[ $code -eq 143 ] || fail "iterative, SIGTERM: exit code $code, expected 143"
+grep -q "iterative" run.log || fail "iterative: the run did not take the iterative path"
+[ -z "$(ls -A "$TMPDIR")" ] ||
+  fail "iterative, SIGTERM: left in TMPDIR: $(ls -AR "$TMPDIR" | head -c 300)"
+(cd "$folder" && md5sum -- * | sort) | cmp -s - before.md5 ||
+  fail "iterative, SIGTERM: the previous result set changed"
+echo "PASS: SIGTERM on the iterative path (MPI up): nothing left in TMPDIR"
+
 # A load path: a folder per case inside the staging folder (the handler
 # removes the whole tree, not one level).
 if [ -n "$load_path_scene" ]; then
