@@ -40,6 +40,8 @@ set-ups and their time, the contact solve, one linear solve by the same path
 (a new hierarchy, CG from zero to the final tolerance), their ratio, the
 peak memory per dof; and up to --direct-max-dofs the automatic choice among
 the direct paths (condensed or sparse) on the same mesh: the crossover.
+Scene "hertz-amg" is the same table in 2D (prm/hertz.prm as in "hertz",
+quadrilaterals, 4 times the cells a step).
 
 Scene "gait" (prm/knee_gait.prm with 11 load cases t = 0:0.1:1) measures
 load cases: per size the first case (assembly and contact solve), the
@@ -229,6 +231,7 @@ def adaptive_benchmark(program, args):
 AMG_SCENES = {
     "knee3d-amg": ("prm/knee_3d.prm", {}),
     "hertz3d-amg": ("prm/hertz_sphere_3d.prm", {}),
+    "hertz-amg": SCENES["hertz"],
 }
 
 

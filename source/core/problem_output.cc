@@ -109,7 +109,11 @@ namespace knee_contact
       TimerOutput::Scope scope(timer, "output");
       vtu.get();
     }
-    // Again, with the VTU's time and any warning of the pictures.
+    // Again, with the VTU's time, any warning of the pictures and the
+    // peak memory including the VTU's (its thread may still have been
+    // building patches when the first summary was written).
+    Utilities::System::get_memory_stats(memory);
+    solver_figures["peak_memory_MB"] = memory.VmHWM / 1024.;
     summary();
   }
 

@@ -117,6 +117,13 @@ namespace knee_contact
                       "stopped (the result set is then kept without "
                       "pictures, with a warning).",
                       Patterns::Double(1));
+    prm.add_parameter("Cells per VTU piece",
+                      cells_per_piece,
+                      "solution.vtu holds its cells in pieces of at most "
+                      "this many (one file; ParaView reads the pieces as "
+                      "one mesh): the writer's memory is that of one piece, "
+                      "about 1 kB per cell, not of the whole mesh.",
+                      Patterns::Integer(1));
     prm.add_parameter("Write files",
                       write_files,
                       "Write solution.vtu, contact CSVs and summary.json.");

@@ -171,6 +171,7 @@ namespace knee_contact
     mutable std::unique_ptr<HelperProcess>          picture_process;
     std::vector<std::string>                        warnings;
     double                                          picture_time_limit = 600;
+    unsigned int                                    cells_per_piece    = 65536;
     std::string                                     output_folder;
     double                                          magnification = 10;
     bool                                            pictures      = true;
