@@ -32,6 +32,9 @@ namespace
                  "fewer refinements or a coarser mesh)"
               << std::endl;
     std::cout.flush();
+    // What the exit handlers would remove (the iterative path's MPI
+    // session folder).
+    knee_contact::interruption::remove_registered();
     std::_Exit(knee_contact::ExitCode::input_error);
   }
 
@@ -51,6 +54,7 @@ main(int argc, char **argv)
     {
       std::cout.flush();
       std::cerr.flush();
+      knee_contact::interruption::remove_registered();
       std::_Exit(code);
     }
   return code;

@@ -107,6 +107,17 @@ namespace knee_contact
       }
 
       void
+      remove_folders_and_files()
+      {
+        for (const auto &folder : folders)
+          if (folder[0] != '\0')
+            remove_tree(AT_FDCWD, folder, 0);
+        for (const auto &file : files)
+          if (file[0] != '\0')
+            unlink(file);
+      }
+
+      void
       handle(const int signal)
       {
         for (auto &child : children)
@@ -119,12 +130,7 @@ namespace knee_contact
                   ;
               }
           }
-        for (const auto &folder : folders)
-          if (folder[0] != '\0')
-            remove_tree(AT_FDCWD, folder, 0);
-        for (const auto &file : files)
-          if (file[0] != '\0')
-            unlink(file);
+        remove_folders_and_files();
         const char message[] = "knee_contact: interrupted by a signal; the "
                                "output folder is unchanged\n";
         [[maybe_unused]] const auto written =
@@ -144,6 +150,14 @@ namespace knee_contact
       sigfillset(&action.sa_mask);
       for (const int signal : {SIGINT, SIGTERM, SIGHUP})
         sigaction(signal, &action, nullptr);
+    }
+
+
+
+    void
+    remove_registered()
+    {
+      remove_folders_and_files();
     }
 
 

@@ -27,6 +27,10 @@ process's mapped size when the path is chosen (summary.json). Then:
    or are refused in one out-of-memory line (the mesh's early estimate is
    cruder than the solver's).
 
+Every run gets a TMPDIR of its own, which must be empty at the end: the
+limited runs leave by std::_Exit, which skips the exit handlers (the
+iterative path's MPI session folder used to stay behind).
+
 Skipped (77) under AddressSanitizer, which reserves terabytes of address
 space at start.
 """
@@ -47,6 +51,8 @@ if len(sys.argv) > 3 and sys.argv[3] == "ON":
 work = tempfile.mkdtemp(prefix="memory_limit-")
 try:
     shutil.copy(os.path.join(root, "prm", "knee.geo"), work)
+    tmpdir = os.path.join(work, "tmp")
+    os.mkdir(tmpdir)
     scene = open(os.path.join(root, "prm", "knee.prm")).read()
     scene += """
 subsection Refinement
@@ -76,7 +82,11 @@ end
         # One malloc arena: glibc reserves 64 MB of address space per
         # thread arena, and fewer when a limit is set, which would make
         # the mapped size of the limited runs differ from the first run's.
-        env = dict(os.environ, MALLOC_ARENA_MAX="1")
+        # A TMPDIR of its own: a run that leaves by std::_Exit (out of
+        # memory, or any run under a limit) skips the exit handlers and
+        # must still leave nothing there (the iterative path's MPI
+        # session folder).
+        env = dict(os.environ, MALLOC_ARENA_MAX="1", TMPDIR=tmpdir)
         done = subprocess.run([program, path], stdout=subprocess.PIPE,
                               stderr=subprocess.STDOUT, text=True,
                               preexec_fn=limit, env=env)
@@ -231,6 +241,9 @@ end
     if not switched:
         ok = False
         print("FAIL: no run switched to the iterative path")
+    left = os.listdir(tmpdir)
+    print("left in TMPDIR by the runs: %s" % (left or "nothing"))
+    ok = ok and not left
     print("PASS" if ok else "FAIL")
     sys.exit(0 if ok else 1)
 finally:

@@ -37,6 +37,15 @@ namespace knee_contact
     void
     unregister_folder(const std::string &folder);
 
+    /**
+     * Remove every registered folder and file now, as the handler would:
+     * for a process that leaves by std::_Exit (out of memory, an
+     * address-space limit), which skips the exit handlers. Allocates
+     * nothing.
+     */
+    void
+    remove_registered();
+
     /** Remove the file @p file if a signal arrives (the lock file). */
     void
     register_file(const std::string &file);
