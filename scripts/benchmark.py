@@ -285,7 +285,8 @@ def amg_benchmark(program, name, args):
             rows.append(row)
             print("%s: %d dofs done" % (name, row["dofs"]), file=sys.stderr,
                   flush=True)
-            if 8 * row["dofs"] > args.max_dofs:
+            # The next refinement's size: 2^dim times the dofs.
+            if 2 ** r["dimension"] * row["dofs"] > args.max_dofs:
                 break
     print("\n%s (%s), Contact/Solver = iterative" % (name, scene))
     header = ("dofs", "pairs", "it", "CG/solve", "CG max", "CG one",
