@@ -167,19 +167,6 @@ namespace knee_contact
 
 
 
-  void
-  ContactInterfaces::check_dimension(const unsigned int dim) const
-  {
-    for (unsigned int i = 0; i < list.size(); ++i)
-      AssertThrow(dim == 2 || list[i].friction == Friction::none,
-                  ExcMessage("Contact/Interface " + std::to_string(i) +
-                             "/Friction: the mesh is 3D and friction is 2D "
-                             "only so far (3D contact is frictionless); set "
-                             "it to none"));
-  }
-
-
-
   template <int dim>
   void
   ContactInterfaces::check_mesh(const Triangulation<dim>        &triangulation,
@@ -399,7 +386,6 @@ namespace knee_contact
       std::any_of(list.begin(), list.end(), [](const ContactInterface &i) {
         return i.friction != Friction::none;
       });
-    std::vector<ContactRow> tangential, stick_x, stick_y;
     for (unsigned int i = 0; i < list.size(); ++i)
       {
         const ContactInterface &interface = list[i];
@@ -418,32 +404,52 @@ namespace knee_contact
           {
             ContactRow &pair       = rows.rows[p];
             const auto &slave_dofs = rows.points[p].slave_dofs;
-            // The tangential row: the rows list each vertex's (x, y)
-            // entries w n_x, w n_y in turn; w t in their place, t the
-            // tangent of the common normal n - n_master where the slave
-            // normal meets the master (of n alone where it meets none).
-            Tensor<1, dim> &t = rows.points[p].tangent;
-            ContactRow      slide;
-            if constexpr (dim == 2)
+            // The frictional rows, built from the normal row, which lists
+            // each vertex's (x, y[, z]) entries w n_x, w n_y[, w n_z] in
+            // turn: the tangential rows with w t_j in their place
+            // (ContactPoint::tangents) and the stick rows with w e_k.
+            const Tensor<1, dim> &n             = rows.points[p].normal;
+            auto                 &t             = rows.points[p].tangents;
+            const auto            weighted_rows = [&](const auto &direction) {
+              ContactRow made;
+              made.interface = pair.interface;
+              made.length    = pair.length;
+              for (std::size_t k = 0; k + dim - 1 < pair.row.size(); k += dim)
+                {
+                  double w = 0;
+                  for (unsigned int d = 0; d < dim; ++d)
+                    w += pair.row[k + d].second * n[d];
+                  for (unsigned int d = 0; d < dim; ++d)
+                    made.row.emplace_back(pair.row[k + d].first,
+                                          w * direction[d]);
+                }
+              return made;
+            };
+            if (friction)
               {
-                const Tensor<1, 2> &n   = rows.points[p].normal;
-                const MasterHit<2>  hit = master_along_normal(
-                  sides, rows.points[p].position, n, pair.length);
-                Tensor<1, 2> m = n;
-                if (hit.face != nullptr)
-                  m -= hit.face->normal;
-                m /= m.norm();
-                t[0]            = -m[1];
-                t[1]            = m[0];
-                slide.interface = pair.interface;
-                slide.length    = pair.length;
-                for (std::size_t k = 0; k + 1 < pair.row.size(); k += 2)
+                if constexpr (dim == 2)
                   {
-                    const Tensor<1, 2> &n = rows.points[p].normal;
-                    const double        w =
-                      pair.row[k].second * n[0] + pair.row[k + 1].second * n[1];
-                    slide.row.emplace_back(pair.row[k].first, w * t[0]);
-                    slide.row.emplace_back(pair.row[k + 1].first, w * t[1]);
+                    const MasterHit<2> hit = master_along_normal(
+                      sides, rows.points[p].position, n, pair.length);
+                    Tensor<1, 2> m = n;
+                    if (hit.face != nullptr)
+                      m -= hit.face->normal;
+                    m /= m.norm();
+                    t[0][0] = -m[1];
+                    t[0][1] = m[0];
+                  }
+                else
+                  {
+                    // Any tangent: the axis least along n, made orthogonal.
+                    unsigned int least = 0;
+                    for (unsigned int d = 1; d < dim; ++d)
+                      if (std::abs(n[d]) < std::abs(n[least]))
+                        least = d;
+                    Tensor<1, dim> e;
+                    e[least] = 1;
+                    t[0]     = e - (e * n) * n;
+                    t[0] /= t[0].norm();
+                    t[1] = cross_product_3d(n, t[0]);
                   }
               }
             // Eliminate the free slave component with the largest
@@ -507,61 +513,51 @@ namespace knee_contact
                 for (const auto &entry : row.reduced_row)
                   in_master_rows.insert(entry.first);
             };
-            // A sticking pair holds both rows; as rows they would
-            // eliminate the slave's two components in terms of each other
-            // (a cycle of constraints) wherever n is not along an axis. So
-            // a sticking pair is held by their combinations that isolate
-            // u_x and u_y of the slave (the slave parts of N and T are n
-            // and t): stick_coefficients().
-            ContactRow x_row, y_row;
-            if constexpr (dim == 2)
-              if (friction)
-                {
-                  const Tensor<1, 2> &n = rows.points[p].normal;
-                  const auto combine    = [&](const double a, const double b) {
-                    ContactRow combined;
-                    combined.interface = pair.interface;
-                    combined.length    = pair.length;
-                    combined.gap       = a * pair.gap + b * slide.gap;
-                    for (std::size_t k = 0; k < pair.row.size(); ++k)
-                      combined.row.emplace_back(pair.row[k].first,
-                                                a * pair.row[k].second +
-                                                  b * slide.row[k].second);
-                    return combined;
-                  };
-                  const auto c = stick_coefficients(n, t);
-                  x_row        = combine(c[0][0], c[0][1]);
-                  y_row        = combine(c[1][0], c[1][1]);
-                }
             choose(pair, true);
-            if (dim == 2 && friction)
+            if (friction)
               {
-                choose(slide, false);
-                slide.measured_only = true;
-                tangential.push_back(std::move(slide));
-                // Never active together with the pair's N or T rows: they
-                // may eliminate the same dofs.
-                for (ContactRow *row : {&x_row, &y_row})
+                for (unsigned int j = 0; j + 1 < dim; ++j)
                   {
-                    reduce_row(*row, constraints);
-                    double largest = 0;
-                    for (const auto &[dof, a] : row->reduced_row)
-                      if ((dof == slave_dofs[0] || dof == slave_dofs[1]) &&
-                          std::abs(a) > largest + 1e-12)
-                        {
-                          largest         = std::abs(a);
-                          row->eliminated = dof;
-                        }
+                    ContactRow slide = weighted_rows(t[j]);
+                    choose(slide, false);
+                    slide.measured_only = true;
+                    pairs.tangential[j].push_back(std::move(slide));
                   }
-                stick_x.push_back(std::move(x_row));
-                stick_y.push_back(std::move(y_row));
+                // A sticking pair holds N and every T_j; as rows they would
+                // eliminate the slave's components in terms of each other (a
+                // cycle of constraints) wherever n is not along an axis. So
+                // it is held by the rows S_k of the weighted jump's
+                // components instead, each eliminating a slave component of
+                // its own (never active together with the pair's N or T
+                // rows: they may eliminate the same dofs). Their gaps follow
+                // from those of N and T (stick_coefficients()).
+                const StickCoefficients c = stick_coefficients<dim>(n, t);
+                std::set<types::global_dof_index> taken;
+                for (unsigned int k = 0; k < dim; ++k)
+                  {
+                    Tensor<1, dim> e;
+                    e[k]                 = 1;
+                    ContactRow component = weighted_rows(e);
+                    component.gap        = c[k][0] * pair.gap;
+                    reduce_row(component, constraints);
+                    double largest = 0;
+                    for (const auto &[dof, a] : component.reduced_row)
+                      if (std::find(slave_dofs.begin(),
+                                    slave_dofs.end(),
+                                    dof) != slave_dofs.end() &&
+                          !taken.count(dof) && std::abs(a) > largest + 1e-12)
+                        {
+                          largest              = std::abs(a);
+                          component.eliminated = dof;
+                        }
+                    if (component.eliminated != numbers::invalid_dof_index)
+                      taken.insert(component.eliminated);
+                    pairs.stick[k].push_back(std::move(component));
+                  }
               }
             pairs.push_back(std::move(pair), rows.points[p]);
           }
       }
-    pairs.tangential = std::move(tangential);
-    pairs.stick_x    = std::move(stick_x);
-    pairs.stick_y    = std::move(stick_y);
     return pairs;
   }
 

@@ -245,7 +245,6 @@ namespace knee_contact
       boundary_ids.insert({interface.slave_id, interface.master_id});
     mesh_input.set_scene_ids(materials.ids(), boundary_ids);
     scene_checks::check_roles(boundary_conditions, contact_interfaces);
-    contact_interfaces.check_dimension(dim);
   }
 
 
@@ -313,7 +312,7 @@ namespace knee_contact
     boundary_conditions.make_constraints(dof_handler, constraints);
     contact_pairs = contact_interfaces.make_pairs(dof_handler, constraints);
     friction_rows.clear();
-    if (!contact_pairs.tangential.empty())
+    if (contact_pairs.frictional())
       friction_rows = contact_pairs.solver_rows();
 
     DynamicSparsityPattern mesh_pattern(dof_handler.n_dofs());
@@ -322,7 +321,7 @@ namespace knee_contact
                                            constraints,
                                            rows_for_solver(),
                                            sparsity_pattern,
-                                           !contact_pairs.tangential.empty());
+                                           contact_pairs.frictional());
     system_matrix.reinit(sparsity_pattern);
   }
 

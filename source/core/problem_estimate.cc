@@ -21,7 +21,7 @@ namespace knee_contact
     std::vector<double>             &mu)
   {
     for (const unsigned int p : patch)
-      AssertThrow(contact_system && contact_pairs.tangential.empty() &&
+      AssertThrow(contact_system && !contact_pairs.frictional() &&
                     p < contact_pairs.size() && contact_solution.active[p],
                   ExcMessage("multiplier_influence: active pairs of a "
                              "solved frictionless problem"));
@@ -79,8 +79,8 @@ namespace knee_contact
   {
     goal_indicators.clear();
     const bool frictionless_contact =
-      contact_system && !contact_pairs.empty() &&
-      contact_pairs.tangential.empty() && contact_solution.converged &&
+      contact_system && !contact_pairs.empty() && !contact_pairs.frictional() &&
+      contact_solution.converged &&
       contact_solution.lambda.size() == contact_pairs.size();
 
     // The goals J = scale times the sum of lambda_q over the pairs of

@@ -268,7 +268,7 @@ namespace knee_contact
         // sticks where it is, so the tangential rows' gaps become the
         // current tangential jumps, and the slip accumulates. The
         // factorised system stays; it is told that the gaps changed.
-        const bool path_step = !new_matrix && !contact_pairs.tangential.empty();
+        const bool path_step = !new_matrix && contact_pairs.frictional();
         if (path_step)
           {
             hold_tangential_rows_at(displacement);
@@ -290,7 +290,7 @@ namespace knee_contact
                                   solver_name,
                                   solver_figures);
           }
-        if (contact_pairs.tangential.empty())
+        if (!contact_pairs.frictional())
           {
             contact_system->set_rhs(system_rhs);
             contact_solution = active_set_solver.solve(*contact_system,
@@ -317,10 +317,9 @@ namespace knee_contact
                   bounds[p] = {true, interface.friction_coefficient, {}};
                 else if (interface.friction == Friction::tresca)
                   bounds[p] = {false, interface.tresca_bound * row.length, {}};
-                if constexpr (dim == 2)
-                  bounds[p].stick =
-                    stick_coefficients(contact_pairs.points[p].normal,
-                                       contact_pairs.points[p].tangent);
+                bounds[p].stick =
+                  stick_coefficients<dim>(contact_pairs.points[p].normal,
+                                          contact_pairs.points[p].tangents);
               }
             contact_solution =
               active_set_solver.solve_with_friction(*contact_system,
@@ -336,7 +335,7 @@ namespace knee_contact
                 for (unsigned int p = 0; p < contact_pairs.size(); ++p)
                   if (contact_solution.status[p] ==
                       ContactSolution::Status::slip)
-                    accumulated[p] += std::abs(contact_solution.slip[p]);
+                    accumulated[p] += magnitude(contact_solution.slip[p]);
                 contact_solution.accumulated_slip = std::move(accumulated);
               }
           }
@@ -345,7 +344,7 @@ namespace knee_contact
         for (const auto &[name, value] : contact_system->statistics())
           solver_figures[name] = value;
         if (new_matrix && active_set_solver.measure_reference() &&
-            contact_pairs.tangential.empty())
+            !contact_pairs.frictional())
           {
             // One linear solve by the same path: CHOLMOD for the direct
             // paths, a new hierarchy and CG from zero for the iterative one.
@@ -407,27 +406,27 @@ namespace knee_contact
   void
   ContactProblem<dim>::hold_tangential_rows_at(const Vector<double> &u)
   {
-    // friction_rows: N (n), T (n), X = a_x N + b_x T, Y = a_y N + b_y T.
-    const unsigned int n = contact_pairs.size();
+    // friction_rows: N, T_j and S_k = sum_i c[k][i] [N; T]_i
+    // (FrictionRowLayout, stick_coefficients()).
+    const unsigned int      n = contact_pairs.size();
+    const FrictionRowLayout at{n, dim};
     for (unsigned int p = 0; p < n; ++p)
       {
-        ContactRow &t_row = friction_rows[n + p];
-        double      jump  = 0;
-        for (const auto &[dof, a] : t_row.row)
-          jump += a * u(dof);
-        const double                         shift = jump - t_row.gap;
-        std::array<std::array<double, 2>, 2> c{{{{0, 0}}, {{0, 0}}}};
-        if constexpr (dim == 2)
-          c = stick_coefficients(contact_pairs.points[p].normal,
-                                 contact_pairs.points[p].tangent);
-        const std::array<std::pair<ContactRow *, double>, 3> moved = {
-          {{&t_row, 1.},
-           {&friction_rows[2 * n + p], c[0][1]},
-           {&friction_rows[3 * n + p], c[1][1]}}};
-        for (const auto &[row, weight] : moved)
+        const StickCoefficients c =
+          stick_coefficients<dim>(contact_pairs.points[p].normal,
+                                  contact_pairs.points[p].tangents);
+        for (unsigned int j = 0; j + 1 < dim; ++j)
           {
-            row->gap += weight * shift;
-            row->reduced_gap += weight * shift;
+            ContactRow  &t_row = friction_rows[at.tangential(j, p)];
+            const double shift = t_row.jump(u) - t_row.gap;
+            t_row.gap += shift;
+            t_row.reduced_gap += shift;
+            for (unsigned int k = 0; k < dim; ++k)
+              {
+                ContactRow &s_row = friction_rows[at.stick(k, p)];
+                s_row.gap += c[k][1 + j] * shift;
+                s_row.reduced_gap += c[k][1 + j] * shift;
+              }
           }
       }
   }

@@ -172,42 +172,80 @@ namespace knee_contact
       std::vector<DataComponentInterpretation::DataComponentInterpretation>(
         dim, DataComponentInterpretation::component_is_scalar));
 
-    // With friction (2D): tangential traction and status (0 open, 1
-    // stick, 2 slip) in one vector, this case's and the accumulated slip in
-    // another.
-    Vector<double> traction_field, slip_field;
+    // With friction, at the slave vertices: 2D, the tangential traction
+    // along t and the status (0 open, 1 stick, 2 slip) in one vector, this
+    // case's and the accumulated slip in another; 3D, the tangential
+    // traction and this case's slip as vectors (Cartesian), the status and
+    // the accumulated slip in a third.
+    std::array<Vector<double>, 3> friction_fields;
     if (contact.status.size() == pairs.size() &&
         contact.accumulated_slip.size() == pairs.size())
       {
-        traction_field.reinit(dof_handler.n_dofs());
-        slip_field.reinit(dof_handler.n_dofs());
+        for (auto &field : friction_fields)
+          field.reinit(dof_handler.n_dofs());
+        auto &[traction_field, slip_field, state_field] = friction_fields;
         for (unsigned int p = 0; p < pairs.size(); ++p)
           {
-            const auto &dofs = pairs.points[p].slave_dofs;
-            traction_field(dofs[0]) =
-              contact.lambda_t[p] / pairs.rows[p].length;
-            traction_field(dofs[1]) = static_cast<int>(contact.status[p]);
-            slip_field(dofs[0])     = contact.slip[p];
-            slip_field(dofs[1])     = contact.accumulated_slip[p];
+            const auto  &dofs   = pairs.points[p].slave_dofs;
+            const double length = pairs.rows[p].length;
+            if constexpr (dim == 2)
+              {
+                traction_field(dofs[0]) = contact.lambda_t[p][0] / length;
+                traction_field(dofs[1]) = static_cast<int>(contact.status[p]);
+                slip_field(dofs[0])     = contact.slip[p][0];
+                slip_field(dofs[1])     = contact.accumulated_slip[p];
+              }
+            else
+              {
+                const Tensor<1, dim> traction =
+                  tangential_vector(pairs.points[p], contact.lambda_t[p]) /
+                  length;
+                const Tensor<1, dim> slip =
+                  tangential_vector(pairs.points[p], contact.slip[p]);
+                for (unsigned int d = 0; d < dim; ++d)
+                  {
+                    traction_field(dofs[d]) = traction[d];
+                    slip_field(dofs[d])     = slip[d];
+                  }
+                state_field(dofs[0]) = static_cast<int>(contact.status[p]);
+                state_field(dofs[1]) = contact.accumulated_slip[p];
+              }
           }
-        for (const auto &[field, names] :
-             {std::make_pair(&traction_field,
-                             std::vector<std::string>{"tangential_traction",
-                                                      "friction_status"}),
-              std::make_pair(&slip_field,
-                             std::vector<std::string>{"slip",
-                                                      "accumulated_slip"})})
+        const auto scalars =
+          std::vector<DataComponentInterpretation::DataComponentInterpretation>(
+            dim, DataComponentInterpretation::component_is_scalar);
+        if constexpr (dim == 2)
           {
-            std::vector<std::string> all = names;
-            if (dim == 3)
-              all.emplace_back("unused");
             data_out.add_data_vector(
-              *field,
-              all,
+              traction_field,
+              std::vector<std::string>{"tangential_traction",
+                                       "friction_status"},
               DataOut<dim>::type_dof_data,
-              std::vector<
-                DataComponentInterpretation::DataComponentInterpretation>(
-                dim, DataComponentInterpretation::component_is_scalar));
+              scalars);
+            data_out.add_data_vector(
+              slip_field,
+              std::vector<std::string>{"slip", "accumulated_slip"},
+              DataOut<dim>::type_dof_data,
+              scalars);
+          }
+        else
+          {
+            data_out.add_data_vector(
+              traction_field,
+              std::vector<std::string>(dim, "tangential_traction"),
+              DataOut<dim>::type_dof_data,
+              vector_field);
+            data_out.add_data_vector(slip_field,
+                                     std::vector<std::string>(dim, "slip"),
+                                     DataOut<dim>::type_dof_data,
+                                     vector_field);
+            data_out.add_data_vector(
+              state_field,
+              std::vector<std::string>{"friction_status",
+                                       "accumulated_slip",
+                                       "unused"},
+              DataOut<dim>::type_dof_data,
+              scalars);
           }
       }
 
@@ -402,26 +440,29 @@ namespace knee_contact
         write_file(name, [&](std::ostream &out) {
           // The discretisation in every row, so that a CSV read on its
           // own says how its pressure was computed.
-          // With friction: the tangent t of the tangential row (the
-          // common normal's, ContactPoint::tangent), the tangential
+          // With friction: 2D, the tangent t of the tangential row (the
+          // common normal's, ContactPoint::tangents), the tangential
           // traction lambda_t / length along t [Pa] (the force on the slave
           // is -lambda_t t), this case's slip t . (u_slave - u_master)
-          // increment [m], the slip accumulated along the load path [m]
-          // and the status.
+          // increment [m]; 3D, the tangential traction and this case's slip
+          // as Cartesian vectors; then the slip accumulated along the load
+          // path [m] and the status.
           const bool friction = contact.status.size() == pairs.size() &&
                                 contact.accumulated_slip.size() == pairs.size();
           out << (dim == 2 ? "arc_length,x,y,n_x,n_y," : "x,y,z,n_x,n_y,n_z,")
-              << "gap,jump,pressure,active,"
-              << (friction ? "t_x,t_y,tangential_traction,slip,"
-                             "accumulated_slip,status,"
-                           : "")
-              << "discretisation\n"
-              << std::setprecision(10);
+              << "gap,jump,pressure,active,";
+          if (friction)
+            out << (dim == 2 ? "t_x,t_y,tangential_traction,slip,"
+                             : "tangential_traction_x,tangential_traction_y,"
+                               "tangential_traction_z,slip_x,slip_y,slip_z,")
+                << "accumulated_slip,status,";
+          out << "discretisation\n" << std::setprecision(10);
           double s = 0;
           for (unsigned int k = 0; k < order.size(); ++k)
             {
-              const ContactPoint<dim> &point = pairs.points[order[k]];
-              const ContactRow        &row   = pairs.rows[order[k]];
+              const unsigned int       p     = order[k];
+              const ContactPoint<dim> &point = pairs.points[p];
+              const ContactRow        &row   = pairs.rows[p];
               if (k > 0)
                 s +=
                   point.position.distance(pairs.points[order[k - 1]].position);
@@ -432,14 +473,29 @@ namespace knee_contact
               for (unsigned int d = 0; d < dim; ++d)
                 out << point.normal[d] << ',';
               out << row.gap << ',' << row.jump(solution) << ','
-                  << results.pressure[order[k]] << ','
-                  << (contact.active[order[k]] ? 1 : 0) << ',';
+                  << results.pressure[p] << ',' << (contact.active[p] ? 1 : 0)
+                  << ',';
               if (friction)
-                out << point.tangent[0] << ',' << point.tangent[1] << ','
-                    << contact.lambda_t[order[k]] / row.length << ','
-                    << contact.slip[order[k]] << ','
-                    << contact.accumulated_slip[order[k]] << ','
-                    << status_name(contact.status[order[k]]) << ',';
+                {
+                  if (dim == 2)
+                    out << point.tangents[0][0] << ',' << point.tangents[0][1]
+                        << ',' << contact.lambda_t[p][0] / row.length << ','
+                        << contact.slip[p][0] << ',';
+                  else
+                    {
+                      const Tensor<1, dim> traction =
+                        tangential_vector(point, contact.lambda_t[p]) /
+                        row.length;
+                      const Tensor<1, dim> slip =
+                        tangential_vector(point, contact.slip[p]);
+                      for (unsigned int d = 0; d < dim; ++d)
+                        out << traction[d] << ',';
+                      for (unsigned int d = 0; d < dim; ++d)
+                        out << slip[d] << ',';
+                    }
+                  out << contact.accumulated_slip[p] << ','
+                      << status_name(contact.status[p]) << ',';
+                }
               out << pairing_name(results.interfaces[i].pairing) << '\n';
             }
         });

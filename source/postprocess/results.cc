@@ -46,9 +46,10 @@ namespace knee_contact
       for (const auto &[dof, a] : pairs.rows[p].row)
         support_force(dof) += a * contact.lambda[p];
     // With friction the tangential forces T^T lambda_t too.
-    for (unsigned int p = 0; p < pairs.tangential.size(); ++p)
-      for (const auto &[dof, a] : pairs.tangential[p].row)
-        support_force(dof) += a * contact.lambda_t[p];
+    for (unsigned int j = 0; j + 1 < dim; ++j)
+      for (unsigned int p = 0; p < pairs.tangential[j].size(); ++p)
+        for (const auto &[dof, a] : pairs.tangential[j][p].row)
+          support_force(dof) += a * contact.lambda_t[p][j];
     // A hanging node's force belongs to the vertices it hangs from:
     // apply the transpose of its constraint.
     {
@@ -179,9 +180,10 @@ namespace knee_contact
         r.force_on_slave -= contact.lambda[p] * pairs.points[p].normal;
         if (!contact.lambda_t.empty())
           {
-            // Along the tangent of the tangential row.
-            r.tangential_force_on_slave -=
-              contact.lambda_t[p] * pairs.points[p].tangent;
+            // Along the tangents of the tangential rows.
+            for (unsigned int j = 0; j + 1 < dim; ++j)
+              r.tangential_force_on_slave -=
+                contact.lambda_t[p][j] * pairs.points[p].tangents[j];
             if (contact.status[p] == ContactSolution::Status::stick)
               {
                 ++r.n_stick;
@@ -191,7 +193,7 @@ namespace knee_contact
               {
                 ++r.n_slip;
                 r.slip_length += pairs.rows[p].length;
-                r.max_slip = std::max(r.max_slip, std::abs(contact.slip[p]));
+                r.max_slip = std::max(r.max_slip, magnitude(contact.slip[p]));
               }
             if (p < contact.accumulated_slip.size())
               r.max_accumulated_slip =

@@ -496,8 +496,10 @@ namespace knee_contact
                  : 0,
                "<=",
                1e-10);
-        report(
-          "complementarity residual", contact.complementarity, "<=", 1e-10);
+        report("complementarity residual",
+               contact.complementarity,
+               "<=",
+               std::max(1e-10, contact.tolerance));
         report(
           "equilibrium residual", results.equilibrium_residual, "<=", 1e-8);
       }

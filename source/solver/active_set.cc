@@ -375,6 +375,7 @@ namespace knee_contact
   {
     const unsigned int n_pairs = pairs.size();
     ContactSolution    result;
+    result.tolerance = tolerance;
     // Start from the guess (the previous load case's or mesh's contact
     // zone) if there is one, else from the pairs that touch (g_p <= 0). A
     // body that

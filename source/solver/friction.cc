@@ -1,6 +1,11 @@
 #include <knee_contact/core/progress.h>
 #include <knee_contact/solver/active_set.h>
 
+#include <deal.II/base/tensor.h>
+
+#include <deal.II/lac/full_matrix.h>
+#include <deal.II/lac/vector.h>
+
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
@@ -16,6 +21,101 @@
 // friction between bodies on rows like these.
 namespace knee_contact
 {
+  namespace
+  {
+    /** a - b as an angle in (-pi, pi]. */
+    double
+    angle_difference(const double a, const double b)
+    {
+      return std::remainder(a - b, 2 * M_PI);
+    }
+
+    /**
+     * Anderson mixing (Walker and Ni, SIAM J. Numer. Anal. 2011) of the
+     * fixed point x = G(x) on the slipping pairs' force angles: from the
+     * last few iterates x_i and residuals f_i = G(x_i) - x_i, the step
+     * x + f - (dX + dF) gamma with gamma minimising |f - dF gamma|. The
+     * history restarts whenever the set of slipping pairs changes. Written
+     * here: no library at hand mixes a fixed point that is a whole solve
+     * of this loop.
+     */
+    class DirectionAcceleration
+    {
+    public:
+      std::vector<double>
+      next(const std::vector<unsigned int> &pairs,
+           const std::vector<double>       &x,
+           const std::vector<double>       &g)
+      {
+        const std::size_t   m = x.size();
+        std::vector<double> f(m);
+        for (std::size_t i = 0; i < m; ++i)
+          f[i] = angle_difference(g[i], x[i]);
+        if (pairs != members)
+          {
+            members = pairs;
+            dx.clear();
+            df.clear();
+          }
+        else if (!last_x.empty())
+          {
+            std::vector<double> step(m), change(m);
+            for (std::size_t i = 0; i < m; ++i)
+              {
+                step[i]   = angle_difference(x[i], last_x[i]);
+                change[i] = f[i] - last_f[i];
+              }
+            dx.push_back(step);
+            df.push_back(change);
+            if (dx.size() > depth)
+              {
+                dx.erase(dx.begin());
+                df.erase(df.begin());
+              }
+          }
+        last_x = x;
+        last_f = f;
+        std::vector<double> result(m);
+        for (std::size_t i = 0; i < m; ++i)
+          result[i] = x[i] + f[i];
+        const std::size_t k = df.size();
+        if (k == 0 || m == 0)
+          return result;
+        // gamma from the normal equations, regularised against columns
+        // that repeat one another.
+        FullMatrix<double> normal(k, k);
+        Vector<double>     right(k), gamma(k);
+        double             trace = 0;
+        for (std::size_t a = 0; a < k; ++a)
+          {
+            for (std::size_t b = 0; b < k; ++b)
+              for (std::size_t i = 0; i < m; ++i)
+                normal(a, b) += df[a][i] * df[b][i];
+            for (std::size_t i = 0; i < m; ++i)
+              right(a) += df[a][i] * f[i];
+            trace += normal(a, a);
+          }
+        if (trace == 0)
+          return result;
+        for (std::size_t a = 0; a < k; ++a)
+          normal(a, a) += 1e-10 * trace;
+        normal.gauss_jordan();
+        normal.vmult(gamma, right);
+        for (std::size_t a = 0; a < k; ++a)
+          for (std::size_t i = 0; i < m; ++i)
+            result[i] -= gamma(a) * (dx[a][i] + df[a][i]);
+        return result;
+      }
+
+    private:
+      static constexpr std::size_t     depth = 8;
+      std::vector<unsigned int>        members;
+      std::vector<double>              last_x, last_f;
+      std::vector<std::vector<double>> dx, df;
+    };
+  } // namespace
+
+
   ContactSolution
   ActiveSetSolver::solve_with_friction(ContactSystem                    &system,
                                        const Vector<double>             &rhs,
@@ -28,29 +128,43 @@ namespace knee_contact
   {
     using Status         = ContactSolution::Status;
     const unsigned int n = bounds.size();
-    AssertThrow(rows.size() == 4 * n, ExcInternalError());
-    ContactSolution result;
-    // The rows of pair p: N p, T n + p, and the two that hold it when it
-    // sticks, X 2n + p and Y 3n + p (ContactPairs::stick_x, stick_y). A
-    // pair in contact that slips has N active, one that sticks X and Y.
+    AssertThrow(n > 0 && rows.size() % (2 * n) == 0 &&
+                  (rows.size() / (2 * n) == 2 || rows.size() / (2 * n) == 3),
+                ExcInternalError());
+    // The rows of each pair: its normal row N, its tangential rows T_j and
+    // the rows S_k that hold it when it sticks (ContactPairs::stick). A
+    // pair in contact that slips has N active, one that sticks every S_k.
+    const FrictionRowLayout at{n,
+                               static_cast<unsigned int>(rows.size() /
+                                                         (2 * n))};
+    const unsigned int      dim = at.dim;
+    ContactSolution         result;
+    result.tolerance     = tolerance;
     const auto can_stick = [&](const unsigned int p) {
-      return bounds[p].value > 0 &&
-             rows[2 * n + p].eliminated != numbers::invalid_dof_index &&
-             rows[3 * n + p].eliminated != numbers::invalid_dof_index;
+      if (bounds[p].value <= 0)
+        return false;
+      for (unsigned int k = 0; k < dim; ++k)
+        if (rows[at.stick(k, p)].eliminated == numbers::invalid_dof_index)
+          return false;
+      return true;
     };
-    const auto set_state = [n](std::vector<bool> &state,
+    const auto set_state = [&](std::vector<bool> &state,
                                const unsigned int p,
                                const bool         contact,
                                const bool         stick) {
-      state[p]         = contact && !stick;
-      state[2 * n + p] = contact && stick;
-      state[3 * n + p] = contact && stick;
+      state[at.normal(p)] = contact && !stick;
+      for (unsigned int k = 0; k < dim; ++k)
+        state[at.stick(k, p)] = contact && stick;
+    };
+    const auto in_contact_in = [&](const std::vector<bool> &state,
+                                   const unsigned int       p) {
+      return state[at.normal(p)] || state[at.stick(0, p)];
     };
     // Start with the touching pairs (or those of the guess: the previous
     // load case's contact zone) in contact and sticking: the state in
     // which friction holds the most.
     AssertThrow(guess.empty() || guess.size() == n, ExcInternalError());
-    std::vector<bool>         active(4 * n, false);
+    std::vector<bool>         active(at.size(), false);
     std::vector<unsigned int> by_gap;
     for (unsigned int p = 0; p < n; ++p)
       if (rows[p].eliminated != numbers::invalid_dof_index)
@@ -65,14 +179,24 @@ namespace knee_contact
       set_state(active, p, true, can_stick(p));
     });
     // The prescribed tangential multipliers of the slipping pairs.
-    std::vector<double> slip_force(n, 0.);
+    std::vector<TangentialVector> slip_force(n, TangentialVector{});
+    // 3D: the slip directions' fixed point, accelerated (see below).
+    DirectionAcceleration acceleration;
+    unsigned int          n_let_go  = 0;
+    bool                  sets_held = false;
     // What the bodies need of friction, measured while everything sticks
-    // (the first iteration): per interface |sum lambda_t| and sum lambda_n.
-    std::map<unsigned int, std::pair<double, double>> needed;
+    // (the first iteration): per interface the sum of the tangential forces
+    // (Cartesian) and of lambda_n.
+    std::map<unsigned int, std::pair<Tensor<1, 3>, double>> needed;
 
-    std::set<std::pair<std::vector<bool>, std::vector<double>>> seen;
-    std::vector<double>                                         excess, lambda;
-    Vector<double> load(rhs.size());
+    // The states seen (the active rows and the slip forces), to stop a
+    // cycle.
+    std::set<std::pair<std::vector<bool>, std::vector<TangentialVector>>> seen;
+    std::vector<double> excess, lambda;
+    Vector<double>      load(rhs.size());
+    const auto          component = [](const double v) {
+      return v == 0 ? 0. : v; // no -0 in the states compared
+    };
     for (unsigned int iteration = 1;; ++iteration)
       {
         if (iteration == 1)
@@ -93,7 +217,20 @@ namespace knee_contact
                               std::to_string(iteration) +
                               " its load pulls it off its contact pairs");
         const std::string free = rigid_modes.free_motion(base, rows, active);
-        if (!free.empty())
+        // A state in which the slipping pairs let a body go may be a
+        // passing one (in 3D, where every pair slips the rotation about
+        // the normal is free, while the solution has a few sticking): the
+        // pairs in contact stick again, twice; the third time friction
+        // cannot hold the body.
+        if (!free.empty() && iteration > 1 && ++n_let_go < 3)
+          {
+            for (unsigned int p = 0; p < n; ++p)
+              if (in_contact_in(active, p))
+                set_state(active, p, true, can_stick(p));
+            slip_force.assign(n, TangentialVector{});
+            seen.clear();
+          }
+        else if (!free.empty())
           {
             // Friction lets go of a body: name the ratio it needed.
             std::ostringstream what;
@@ -101,8 +238,7 @@ namespace knee_contact
             for (const auto &[interface, forces] : needed)
               if (forces.second > 0)
                 what << " (interface " << interface << ": tangential/normal "
-                     << "force " << std::abs(forces.first) / forces.second
-                     << ")";
+                     << "force " << forces.first.norm() / forces.second << ")";
             AssertThrow(false,
                         ExcMessage(
                           free +
@@ -117,46 +253,69 @@ namespace knee_contact
           }
         load = rhs;
         for (unsigned int p = 0; p < n; ++p)
-          if (slip_force[p] != 0)
-            for (const auto &[dof, a] : rows[n + p].row)
-              load(dof) -= slip_force[p] * a;
+          for (unsigned int j = 0; j + 1 < dim; ++j)
+            if (slip_force[p][j] != 0)
+              for (const auto &[dof, a] : rows[at.tangential(j, p)].row)
+                load(dof) -= slip_force[p][j] * a;
         system.set_rhs(load);
         system.solve(active, excess, lambda);
         // lambda_n and lambda_t of each pair: of a sticking pair from the
-        // multipliers of its X and Y rows (stick_coefficients()).
+        // multipliers of its stick rows (stick_coefficients()).
+        std::vector<TangentialVector> lambda_t(n, TangentialVector{});
+        std::vector<TangentialVector> slip(n, TangentialVector{});
         for (unsigned int p = 0; p < n; ++p)
-          if (active[2 * n + p])
-            {
-              const auto  &c  = bounds[p].stick;
-              const double lx = lambda[2 * n + p], ly = lambda[3 * n + p];
-              lambda[p]     = lx * c[0][0] + ly * c[1][0];
-              lambda[n + p] = lx * c[0][1] + ly * c[1][1];
-            }
-          else
-            lambda[n + p] = active[p] ? slip_force[p] : 0.;
-        lambda.resize(2 * n);
+          {
+            for (unsigned int j = 0; j + 1 < dim; ++j)
+              slip[p][j] = excess[at.tangential(j, p)];
+            if (active[at.stick(0, p)])
+              {
+                const auto &c = bounds[p].stick;
+                lambda[p]     = 0;
+                for (unsigned int k = 0; k < dim; ++k)
+                  {
+                    const double l = lambda[at.stick(k, p)];
+                    lambda[p] += l * c[k][0];
+                    for (unsigned int j = 0; j + 1 < dim; ++j)
+                      lambda_t[p][j] += l * c[k][1 + j];
+                  }
+              }
+            else if (active[p])
+              lambda_t[p] = slip_force[p];
+          }
+        lambda.resize(n);
         const auto in_contact = [&](const unsigned int p) {
-          return active[p] || active[2 * n + p];
+          return in_contact_in(active, p);
         };
         if (iteration == 1)
           for (unsigned int p = 0; p < n; ++p)
             if (in_contact(p))
               {
+                // The Cartesian tangential force: sum_j lambda_t,j t_j with
+                // t_j the rows of c^-1 after the normal's.
+                Tensor<2, 3> F;
+                for (unsigned int i = 0; i < 3; ++i)
+                  for (unsigned int k = 0; k < 3; ++k)
+                    F[k][i] = i < dim && k < dim ? bounds[p].stick[k][i]
+                                                 : double(i == k);
+                F                 = invert(F);
                 auto &[t, normal] = needed[rows[p].interface];
-                t += lambda[n + p];
+                for (unsigned int j = 0; j + 1 < dim; ++j)
+                  t += lambda_t[p][j] * F[1 + j];
                 normal += lambda[p];
               }
 
         double lambda_scale = 0;
-        for (const double l : lambda)
-          lambda_scale = std::max(lambda_scale, std::abs(l));
+        for (unsigned int p = 0; p < n; ++p)
+          lambda_scale = std::max(
+            {lambda_scale, std::abs(lambda[p]), magnitude(lambda_t[p])});
         if (lambda_scale == 0)
           lambda_scale = 1;
         const double u_scale = std::max(system.displacement_scale(), 1e-300);
         const double force_scale = rhs.linfty_norm() + lambda_scale;
 
-        std::vector<bool>   next(4 * n, false);
-        std::vector<double> next_force(n, 0.);
+        std::vector<bool>             next(at.size(), false);
+        std::vector<TangentialVector> next_force(n, TangentialVector{});
+        std::vector<TangentialVector> proposed_direction(n, TangentialVector{});
         result.complementarity    = 0;
         result.max_penetration    = -std::numeric_limits<double>::max();
         double       force_change = 0;
@@ -180,26 +339,42 @@ namespace knee_contact
                                    ? bounds[p].value * std::max(lambda[p], 0.)
                                    : bounds[p].value;
             // A sticking pair slips where its tangential force exceeds the
-            // bound, in the force's direction; a slipping pair sticks where
-            // it would slip against its friction force; a pair that comes
-            // into contact starts sticking. (Complementarity with the
-            // constant c, lambda_t + c s, oscillates between the two
+            // bound, in the force's direction; a slipping pair sticks, in
+            // 2D, where it would slip against its friction force
+            // (s . d < 0), in 3D by the semismooth rule below, which also
+            // turns its direction; a pair that comes into contact starts
+            // slipping the way it moved while open. (Complementarity with
+            // the constant c, lambda_t + c s, oscillates between the two
             // directions of slip where c s outweighs the bound, measured on
-            // the knee; these are its limits c -> 0 and c -> infinity.)
-            const double t_force = lambda[n + p], s = excess[n + p];
-            bool         stick = true;
-            double direction = slip_force[p] != 0 ? (slip_force[p] > 0 ? 1 : -1)
-                                                  : (t_force + s >= 0 ? 1 : -1);
-            if (active[2 * n + p])
+            // the 2D knee; these are its limits c -> 0 and c -> infinity.)
+            const TangentialVector &t_force = lambda_t[p];
+            const TangentialVector &s       = slip[p];
+            const double            s_norm  = magnitude(s);
+            const auto              unit    = [](const TangentialVector &v) {
+              const double length = magnitude(v);
+              return length > 0
+                                       ? TangentialVector{{v[0] / length, v[1] / length}}
+                                       : TangentialVector{};
+            };
+            bool             stick     = true;
+            TangentialVector direction = unit(slip_force[p]);
+            if (magnitude(direction) == 0)
               {
-                stick     = std::abs(t_force) <= bound + 1e-12 * force_scale;
-                direction = t_force >= 0 ? 1 : -1;
+                // No force yet (a bound of zero): the way it moved, or
+                // along t_1.
+                direction = s_norm > 0 ? unit(s) : TangentialVector{{1, 0}};
+              }
+            if (active[at.stick(0, p)])
+              {
+                const double t_norm = magnitude(t_force);
+                stick               = t_norm <= bound + 1e-12 * force_scale;
+                if (t_norm > 0)
+                  direction = unit(t_force);
                 result.complementarity =
                   std::max(result.complementarity,
-                           std::max(0., std::abs(t_force) - bound) /
-                             lambda_scale);
+                           std::max(0., t_norm - bound) / lambda_scale);
               }
-            else if (!active[p] && s != 0)
+            else if (!active[p] && s_norm != 0)
               {
                 // A pair that comes into contact slips the way it moved
                 // while open (the large-c limit of the complementarity
@@ -208,25 +383,97 @@ namespace knee_contact
                 // knee took 40 iterations instead of 15 at mu = 0.04
                 // (measured with the slave's own tangent).
                 stick     = false;
-                direction = s > 0 ? 1 : -1;
+                direction = unit(s);
               }
             else if (active[p])
               {
-                if (slip_force[p] == 0)
-                  direction = s >= 0 ? 1 : -1;
-                stick = direction * s < 0;
-                result.complementarity =
-                  std::max(result.complementarity,
-                           std::max(0., -direction * s) / u_scale);
+                const double along = direction[0] * s[0] + direction[1] * s[1];
+                stick              = along < 0;
+                // What the slip has across its force (zero at the
+                // solution: the force opposes the slip).
+                const double across =
+                  std::sqrt(std::max(0., s_norm * s_norm - along * along));
+                // (Without a bound, any slip satisfies the law.)
+                if (bound > 0)
+                  result.complementarity =
+                    std::max({result.complementarity,
+                              std::max(0., -along) / u_scale,
+                              across / u_scale});
+                if (dim == 3 && bound > 0)
+                  {
+                    // 3D: the semismooth rule of Hueber, Stadler and
+                    // Wohlmuth with lambda_t = bound d: stick where
+                    // |lambda_t + c_t s| <= bound, else the force bound
+                    // (lambda_t + c_t s) / |...|, with c_t = 0.01 E_max h
+                    // for a pair of spacing h (chosen on the stacked cubes
+                    // of tests/drivers/friction_3d.py: 0.03 let every pair
+                    // slip at once, 0 turned the directions in circles).
+                    const double ct =
+                      0.01 * c / c_relative * rows[p].spacing(dim);
+                    const TangentialVector v{
+                      {bound * direction[0] + ct * s[0],
+                       bound * direction[1] + ct * s[1]}};
+                    stick = magnitude(v) <= bound;
+                    if (!stick)
+                      proposed_direction[p] = direction = unit(v);
+                  }
+                else if (!stick && s_norm > 0)
+                  proposed_direction[p] = direction = unit(s);
               }
             stick = stick && can_stick(p);
             set_state(next, p, true, stick);
             if (stick)
               ++n_stick;
             else
-              next_force[p] = direction * bound;
-            force_change =
-              std::max(force_change, std::abs(next_force[p] - slip_force[p]));
+              for (unsigned int j = 0; j + 1 < dim; ++j)
+                next_force[p][j] = component(direction[j] * bound);
+            const TangentialVector change{
+              {next_force[p][0] - slip_force[p][0],
+               next_force[p][1] - slip_force[p][1]}};
+            force_change = std::max(force_change, magnitude(change));
+          }
+        // 3D: while the sets stay, the slipping pairs' force directions
+        // (angles in their tangent planes) are a fixed point of the rule
+        // above, which converges slowly where the slip is small beside the
+        // elastic response to turning the force (near the stick zone): it
+        // is accelerated (Anderson mixing, the multisecant form of Newton's
+        // method on the angles).
+        if (dim == 3)
+          {
+            std::vector<unsigned int> slipping;
+            for (unsigned int p = 0; p < n; ++p)
+              if (next[p] && active[p] && magnitude(slip_force[p]) > 0 &&
+                  magnitude(next_force[p]) > 0 &&
+                  magnitude(proposed_direction[p]) > 0)
+                slipping.push_back(p);
+            if (next != active || !sets_held)
+              slipping.clear();
+            sets_held = next == active;
+            std::vector<double> angle(slipping.size()),
+              proposed(slipping.size());
+            for (unsigned int i = 0; i < slipping.size(); ++i)
+              {
+                const auto &now = slip_force[slipping[i]];
+                const auto &to  = proposed_direction[slipping[i]];
+                angle[i]        = std::atan2(now[1], now[0]);
+                proposed[i]     = std::atan2(to[1], to[0]);
+              }
+            const std::vector<double> mixed =
+              acceleration.next(slipping, angle, proposed);
+            force_change = 0;
+            for (unsigned int i = 0; i < slipping.size(); ++i)
+              {
+                auto        &to    = next_force[slipping[i]];
+                const double bound = magnitude(to);
+                to                 = {{component(bound * std::cos(mixed[i])),
+                                       component(bound * std::sin(mixed[i]))}};
+              }
+            for (unsigned int p = 0; p < n; ++p)
+              force_change =
+                std::max(force_change,
+                         magnitude(TangentialVector{
+                           {next_force[p][0] - slip_force[p][0],
+                            next_force[p][1] - slip_force[p][1]}}));
           }
         result.n_iterations = iteration;
         log << "   friction iteration " << std::setw(2) << iteration << ": "
@@ -242,24 +489,28 @@ namespace knee_contact
         // load path reads them).
         result.active.assign(n, false);
         result.status.assign(n, Status::open);
-        result.slip.assign(n, 0.);
+        result.slip.assign(n, TangentialVector{});
         for (unsigned int p = 0; p < n; ++p)
           if (in_contact(p))
             {
               result.active[p] = true;
               result.status[p] =
-                active[2 * n + p] ? Status::stick : Status::slip;
+                active[at.stick(0, p)] ? Status::stick : Status::slip;
               // The slip of a pair in contact (an open pair's tangential
               // jump is no slip).
               if (result.status[p] == Status::slip)
-                result.slip[p] = excess[n + p];
+                result.slip[p] = slip[p];
             }
-        result.lambda.assign(lambda.begin(), lambda.begin() + n);
-        result.lambda_t.assign(lambda.begin() + n, lambda.begin() + 2 * n);
+        result.lambda   = lambda;
+        result.lambda_t = lambda_t;
         if (next == active && force_change <= tolerance * force_scale &&
             result.complementarity <= tolerance)
           return result;
-        if (next == active && force_change <= tolerance * force_scale)
+        // Settled: 2D, the slip forces within the tolerance; 3D, the slip
+        // directions no longer turn (while they turn, the slip across its
+        // force still shrinks).
+        if (next == active &&
+            force_change <= (dim == 2 ? 1 : 1e-3) * tolerance * force_scale)
           {
             result.converged = false;
             result.failure   = "the contact and stick sets settled but the "

@@ -62,7 +62,7 @@ namespace
     const auto        &pairs = problem.pairs();
     const unsigned int n     = K.m();
     const unsigned int M     = pairs.size();
-    AssertThrow(pairs.tangential.size() == M, ExcInternalError());
+    AssertThrow(pairs.tangential[0].size() == M, ExcInternalError());
 
     // x = C0 z + g0 over the dofs free of Gamma_u.
     const FreeDofs     reduced(K, f, base);
@@ -77,8 +77,9 @@ namespace
     Vector<double>     c(2 * M);
     for (unsigned int r = 0; r < 2 * M; ++r)
       {
-        const ContactRow &row = r < M ? pairs.rows[r] : pairs.tangential[r - M];
-        c(r)                  = row.gap;
+        const ContactRow &row =
+          r < M ? pairs.rows[r] : pairs.tangential[0][r - M];
+        c(r) = row.gap;
         for (const auto &[dof, a] : row.row)
           {
             c(r) -= a * g0(dof);
@@ -208,7 +209,7 @@ namespace
         if (loop.status[p] == Status::stick)
           mine = stick;
         else if (loop.status[p] == Status::slip)
-          mine = loop.lambda_t[p] > 0 ? slip_plus : slip_minus;
+          mine = loop.lambda_t[p][0] > 0 ? slip_plus : slip_minus;
         same_states = same_states && mine == reference_state[p];
         std::cout << p << "     " << name(reference_state[p]) << "        "
                   << name(mine) << std::endl;
@@ -222,7 +223,7 @@ namespace
     for (unsigned int p = 0; p < M; ++p)
       lambda_error = std::max({lambda_error,
                                std::abs(loop.lambda[p] - reference_n[p]),
-                               std::abs(loop.lambda_t[p] - reference_t[p])});
+                               std::abs(loop.lambda_t[p][0] - reference_t[p])});
     lambda_error /= lambda_scale;
     // The scene is meant to hold each state once (a test of all three).
     unsigned int seen = 0;

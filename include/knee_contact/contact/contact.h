@@ -5,6 +5,7 @@
 
 #include <deal.II/base/parameter_handler.h>
 #include <deal.II/base/point.h>
+#include <deal.II/base/tensor.h>
 
 #include <deal.II/lac/affine_constraints.h>
 
@@ -36,29 +37,62 @@ namespace knee_contact
     /** Dof indices of the slave vertex (x, y[, z]). */
     std::array<types::global_dof_index, dim> slave_dofs;
     /**
-     * With friction (2D): the unit tangent of the pair's tangential row,
+     * With friction: the unit tangents of the pair's tangential rows. 2D:
      * that of the common normal n - n_master (n_master: the master face
-     * the slave normal meets), t = (-m_y, m_x) for m the common normal.
-     * On curved sides both normals tilt over the contact zone; the slave's
-     * alone would count part of the normal approach as slip.
+     * the slave normal meets), t = (-m_y, m_x) for m the common normal; on
+     * curved sides both normals tilt over the contact zone, and the
+     * slave's alone would count part of the normal approach as slip. 3D:
+     * two orthonormal tangents of the slave normal n (t_2 = n x t_1; the
+     * slave normal of a 3D row is its mortar-averaged nodal normal, which
+     * already leans on both sides' geometry).
      */
-    Tensor<1, dim> tangent;
+    std::array<Tensor<1, dim>, dim - 1> tangents;
   };
 
 
 
   /**
-   * The combinations a N + b T of a pair's normal and tangential rows
-   * whose slave parts (n and t) are e_x and e_y: {{a_x, b_x}, {a_y, b_y}},
-   * the inverse of the matrix with columns n and t. A sticking pair is
-   * held by these two rows; their multipliers l_x, l_y are
-   * lambda_n = l_x a_x + l_y a_y and lambda_t = l_x b_x + l_y b_y.
+   * The Cartesian vector of a pair's tangential quantity @p v (multiplier,
+   * slip) given along its tangents: sum_j v_j t_j.
    */
-  inline std::array<std::array<double, 2>, 2>
-  stick_coefficients(const Tensor<1, 2> &n, const Tensor<1, 2> &t)
+  template <int dim>
+  Tensor<1, dim>
+  tangential_vector(const ContactPoint<dim> &point, const TangentialVector &v)
   {
-    const double det = n[0] * t[1] - n[1] * t[0];
-    return {{{{t[1] / det, -n[1] / det}}, {{-t[0] / det, n[0] / det}}}};
+    Tensor<1, dim> cartesian;
+    for (unsigned int j = 0; j + 1 < dim; ++j)
+      cartesian += v[j] * point.tangents[j];
+    return cartesian;
+  }
+
+
+
+  /**
+   * How a frictional pair's stick rows S_k (the k-th component of the
+   * weighted jump, which hold it while it sticks) and its normal and
+   * tangential rows N, T_j combine: with F the matrix of rows n, t_1[, t_2],
+   * [N; T] = F S, so S_k = sum_i c[k][i] [N; T]_i and the multipliers
+   * [lambda_n; lambda_t] = c^T lambda_S, c = F^-1. Entries beyond dim are
+   * zero.
+   */
+  template <int dim>
+  StickCoefficients
+  stick_coefficients(const Tensor<1, dim>                      &n,
+                     const std::array<Tensor<1, dim>, dim - 1> &t)
+  {
+    Tensor<2, dim> F;
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        F[0][d] = n[d];
+        for (unsigned int j = 0; j + 1 < dim; ++j)
+          F[1 + j][d] = t[j][d];
+      }
+    const Tensor<2, dim> inverse = invert(F);
+    StickCoefficients    c{};
+    for (unsigned int k = 0; k < dim; ++k)
+      for (unsigned int i = 0; i < dim; ++i)
+        c[k][i] = inverse[k][i];
+    return c;
   }
 
 
@@ -72,29 +106,38 @@ namespace knee_contact
     std::vector<ContactRow>        rows;
     std::vector<ContactPoint<dim>> points;
     /**
-     * With friction on any interface: for each row p the tangential row
-     * t_p . (u_slave - u_master) [rows[p]'s weights, the tangent
-     * points[p].tangent in place of n], gap 0 (loaded in one step; along
-     * a load path the last case's jump); empty if no interface has
-     * friction.
+     * With friction on any interface: for each row p and tangent j the
+     * tangential row t_j . (u_slave - u_master) [rows[p]'s weights, the
+     * tangent points[p].tangents[j] in place of n], gap 0 (loaded in one
+     * step; along a load path the last case's jump); empty if no
+     * interface has friction.
      */
-    std::vector<ContactRow> tangential;
+    std::array<std::vector<ContactRow>, dim - 1> tangential;
     /**
-     * With friction: the rows that hold a sticking pair, the combinations
-     * of N and T whose slave parts are e_x and e_y (see make_pairs).
+     * With friction: the rows that hold a sticking pair, the components
+     * e_k . (u_slave - u_master) with rows[p]'s weights (see make_pairs).
      */
-    std::vector<ContactRow> stick_x, stick_y;
+    std::array<std::vector<ContactRow>, dim> stick;
+
+    /** Whether any interface has friction (the rows above exist). */
+    bool
+    frictional() const
+    {
+      return !tangential[0].empty();
+    }
 
     /**
-     * The rows the solver sees: the normal rows, then the tangential, then
-     * stick_x and stick_y.
+     * The rows the solver sees, as FrictionRowLayout orders them: the
+     * normal rows, then the tangential, then the stick rows.
      */
     std::vector<ContactRow>
     solver_rows() const
     {
       std::vector<ContactRow> all = rows;
-      for (const auto *more : {&tangential, &stick_x, &stick_y})
-        all.insert(all.end(), more->begin(), more->end());
+      for (const auto &more : tangential)
+        all.insert(all.end(), more.begin(), more.end());
+      for (const auto &more : stick)
+        all.insert(all.end(), more.begin(), more.end());
       return all;
     }
 
@@ -193,13 +236,6 @@ namespace knee_contact
     void
     check_parameters() const;
 
-    /**
-     * Throw if an interface asks for what the mesh's dimension @p dim
-     * lacks: friction in 3D.
-     */
-    void
-    check_dimension(const unsigned int dim) const;
-
     /** 'Number of interfaces' as the scene gives it. */
     unsigned int n_interfaces = 0;
 
@@ -215,8 +251,8 @@ namespace knee_contact
     /**
      * Pair every slave vertex of every interface (see ContactPoint), and
      * choose each row's eliminated dof given the Gamma_u/Gamma_o
-     * @p constraints (closed). 2D and 3D; friction rows in 2D only (3D
-     * friction is refused by check_dimension()).
+     * @p constraints (closed). 2D and 3D, with friction the tangential and
+     * stick rows too.
      */
     template <int dim>
     ContactPairs<dim>

@@ -360,7 +360,8 @@ namespace knee_contact
     AffineConstraints<double> constraints;
     ContactPairs<dim>         contact_pairs;
     /**
-     * With friction: the normal then the tangential rows, which the
+     * With friction: the normal, tangential and stick rows
+     * (ContactPairs::solver_rows()), which the
      * contact system keeps a reference to (see rows_for_solver()).
      */
     std::vector<ContactRow> friction_rows;
@@ -377,8 +378,7 @@ namespace knee_contact
     const std::vector<ContactRow> &
     rows_for_solver() const
     {
-      return contact_pairs.tangential.empty() ? contact_pairs.rows
-                                              : friction_rows;
+      return !contact_pairs.frictional() ? contact_pairs.rows : friction_rows;
     }
     SparsityPattern      sparsity_pattern;
     SparseMatrix<double> system_matrix;

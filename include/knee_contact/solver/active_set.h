@@ -36,17 +36,20 @@ namespace knee_contact
     bool         converged      = true;
     std::string  failure; // why not, if not converged
     double       complementarity = 0;
-    double       max_penetration = 0; // max (A x - g)_p [m]
+    /** The Contact/Tolerance the loop converged to (the KKT check's). */
+    double tolerance       = 1e-10;
+    double max_penetration = 0; // max (A x - g)_p [m]
 
     /**
      * With friction (solve_with_friction()), per pair: the tangential
-     * multiplier [N/m] (the force on the slave is -lambda_t t, t the
-     * pair's tangent), the slip t . (u_slave - u_master) less the
-     * tangential row's gap [m] of a slipping pair (zero where it sticks or
-     * is open), and the status. Empty without friction.
+     * multiplier [N/m in 2D, N in 3D] by its components along the pair's
+     * tangents t_j (the force on the slave is -sum_j lambda_t,j t_j), the
+     * slip t_j . (u_slave - u_master) less the tangential rows' gaps [m] of
+     * a slipping pair (zero where it sticks or is open), and the status.
+     * Empty without friction.
      */
-    std::vector<double> lambda_t;
-    std::vector<double> slip;
+    std::vector<TangentialVector> lambda_t;
+    std::vector<TangentialVector> slip;
     /**
      * Along a load path (Load cases/Values of t with friction): per pair
      * the slip of this case is its increment since the previous case, and
@@ -60,7 +63,10 @@ namespace knee_contact
       slip
     };
     std::vector<Status> status;
-    /** Fixed-point updates of the Coulomb bounds after the sets settled. */
+    /**
+     * Fixed-point updates of the Coulomb bounds and the slip directions
+     * after the sets settled.
+     */
     unsigned int n_bound_updates = 0;
   };
 
@@ -90,11 +96,10 @@ namespace knee_contact
     bool   coulomb = false;
     double value   = 0;
     /**
-     * How the pair's X and Y rows (which hold it while it sticks) combine
-     * its normal and tangential rows: {{a_x, b_x}, {a_y, b_y}}, see
-     * stick_coefficients() (2D).
+     * How the pair's stick rows (which hold it while it sticks) combine
+     * its normal and tangential rows, see stick_coefficients().
      */
-    std::array<std::array<double, 2>, 2> stick{{{{0, 0}}, {{0, 0}}}};
+    StickCoefficients stick{};
   };
 
 

@@ -5,6 +5,7 @@
 
 #include <deal.II/lac/vector.h>
 
+#include <array>
 #include <cmath>
 #include <utility>
 #include <vector>
@@ -50,8 +51,8 @@ namespace knee_contact
     bool                    slave_eliminated = true;
     /**
      * A row the loop only measures and never holds as an equality (the
-     * tangential row of a frictional pair: its slip; a sticking pair is
-     * held by its stick_x and stick_y rows). The condensed path leaves it
+     * tangential rows of a frictional pair: its slip; a sticking pair is
+     * held by its stick rows). The condensed path leaves it
      * out of its per-iteration system, and the solver choice counts it.
      */
     bool measured_only = false;
@@ -76,6 +77,62 @@ namespace knee_contact
       return value;
     }
   };
+
+
+
+  /**
+   * Where the rows of frictional pair p sit in the solver's list
+   * (ContactPairs::solver_rows()): the n normal rows N, then dim - 1
+   * blocks of n tangential rows T_j, then dim blocks of n stick rows S_k.
+   */
+  struct FrictionRowLayout
+  {
+    unsigned int n_pairs = 0;
+    unsigned int dim     = 2;
+
+    unsigned int
+    normal(const unsigned int p) const
+    {
+      return p;
+    }
+
+    unsigned int
+    tangential(const unsigned int j, const unsigned int p) const
+    {
+      return (1 + j) * n_pairs + p;
+    }
+
+    unsigned int
+    stick(const unsigned int k, const unsigned int p) const
+    {
+      return (dim + k) * n_pairs + p;
+    }
+
+    unsigned int
+    size() const
+    {
+      return 2 * dim * n_pairs;
+    }
+  };
+
+  /**
+   * A frictional pair's stick_coefficients() (contact.h): up to 3 x 3, the
+   * entries beyond dim zero.
+   */
+  using StickCoefficients = std::array<std::array<double, 3>, 3>;
+
+  /**
+   * A tangential quantity of a pair (multiplier, slip) by its components
+   * along the pair's dim - 1 tangents; the second is zero in 2D.
+   */
+  using TangentialVector = std::array<double, 2>;
+
+  /** Its length. */
+  inline double
+  magnitude(const TangentialVector &v)
+  {
+    return std::sqrt(v[0] * v[0] + v[1] * v[1]);
+  }
 } // namespace knee_contact
 
 #endif

@@ -1,0 +1,317 @@
+#!/usr/bin/python3
+"""Coulomb friction in 3D against independent references, one load step.
+
+1. mu = 0 reproduces the frictionless results: the 3D contact patch tests
+   (hexahedra, node-to-segment and mortar; tetrahedra) and the small Hertz
+   sphere are run as they are and with Friction = coulomb, Friction
+   coefficient = 0 on every interface (both on the sparse path): every
+   number of summary.json agrees to 1e-12 relative to the largest of its
+   kind (the friction rows change the factorisation's ordering: round-off).
+2. A very large mu reproduces the bonded solution on matching meshes: two
+   unit cubes (2 cells a side each, tests/meshes/contact_stack_3d.geo, the
+   lower one's bottom held) with mu = 1e3 under a traction
+   (5e4, 2.5e4, -1e6) Pa on the top (no edge lifts), node-to-node pairing (every pair
+   sticks), against the box of tests/meshes/block.geo with the same two
+   materials sharing the interface's nodes: energy, max |u| and the
+   reaction to 1e-10.
+3. Statics of the upper cube held by friction only (its sides free), a
+   tangential load skew to every mesh axis (angle 0.3 rad from x, ratio
+   r = 0.2 of the normal load), non-matching meshes (4 cells a side below,
+   3 above): with mu = 0.5 > r the interface force on the slave balances
+   the load to 1e-8 relative (node-to-segment and mortar); with
+   mu = 0.1 < r the run is refused in one line naming the ratio 0.2.
+4. The same on a tilted interface: the stack rotated by 0.7 rad about the
+   skew axis (1, 2, 3) with the load rotated along (a tangential ratio
+   0.8 mu and 1.2 mu in the interface's frame, mu = 0.3): below, the
+   interface force balances the load to 1e-8; above, one line refuses it
+   naming the ratio 1.2 x 0.3 = 0.36.
+The loop's iterations are printed: 22-27 on the level stack, 58-74 on the
+tilted one (the scenes allow 100; the semismooth rule's fixed point on the
+slip directions converges slowly, issue 37's open goal is 15). The tilted
+stack's Contact/Tolerance is 1e-8: its slip across the force stalls at
+2.5e-9 of the displacements.
+Usage: friction_3d.py KNEE_CONTACT
+"""
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SCENES = os.path.join(HERE, "..", "scenes")
+MESHES = os.path.join(HERE, "..", "meshes")
+sys.path.insert(0, HERE)
+from friction import numbers, with_output  # noqa: E402
+
+FRICTIONLESS = [("contact_patch_3d_hex.prm", 1e-12),
+                ("contact_patch_3d_tet.prm", 1e-12),
+                ("contact_patch_3d_matching.prm", 1e-12),
+                ("hertz_sphere_3d_small.prm", 1e-12)]
+
+MATERIALS = """subsection Materials
+  set Number of materials = 2
+  subsection Material 0
+    set Material id     = 1
+    set Name            = base
+    set Young's modulus = 1e9
+    set Poisson's ratio = 0.3
+  end
+  subsection Material 1
+    set Material id     = 2
+    set Name            = block
+    set Young's modulus = 3e9
+    set Poisson's ratio = 0.2
+  end
+end
+"""
+
+# The stack: boundary ids 3 bottom, 4 top, 5 top of the lower cube, 6
+# bottom of the upper one.
+STACK = """
+subsection Mesh
+  set Source         = file
+  set File           = {mesh}
+  set Gmsh arguments = -setnumber n_lower {lower} -setnumber n_upper {upper} \\
+                       -setnumber angle {angle}
+end
+{materials}subsection Boundary conditions
+  set Number of conditions = 2
+  subsection Condition 0
+    set Boundary ids = {bottom}
+    set Type         = displacement
+  end
+  subsection Condition 1
+    set Boundary ids = {top}
+    set Type         = traction
+    set Value        = {tx!r}; {ty!r}; {tz!r}
+  end
+end
+subsection Contact
+  set Maximum active set iterations = 100
+  set Tolerance = {tolerance}
+  set Number of interfaces = {n_interfaces}
+{interface}
+end
+subsection Output
+  set Folder   = {folder}
+  set Pictures = false
+end
+"""
+
+INTERFACE = """  subsection Interface 0
+    set Name                 = block
+    set Slave boundary id    = 6
+    set Master boundary id   = 5
+    set Pairing              = {pairing}
+    set Friction             = coulomb
+    set Friction coefficient = {mu}
+  end"""
+
+
+def compare(name, reference, other, tolerance):
+    """Every number of two summaries, relative to the largest of its kind;
+    the stresses of every kind relative to the largest stress (a patch
+    test's zero components are round-off)."""
+    a, b = dict(numbers(reference)), dict(numbers(other))
+    assert a.keys() == b.keys(), (name, a.keys() ^ b.keys())
+
+    def kind(key):
+        top = key.split("/")[1]
+        return "stress" if "stress" in top or "mises" in top else top
+    worst, failures = 0.0, 0
+    for key in a:
+        if kind(key) in ("equilibrium_residual", "relative_max_penetration",
+                         "complementarity_residual", "max_penetration"):
+            continue  # round-off measures
+        scale = max(abs(v) for k, v in a.items()
+                    if kind(k) == kind(key)) or 1.0
+        error = abs(a[key] - b[key]) / scale
+        worst = max(worst, error)
+        if error > tolerance:
+            print("FAIL %s: %s = %r, reference %r" % (name, key, b[key],
+                                                     a[key]))
+            failures += 1
+    print("%s: %d numbers, largest relative difference %.1e (tolerance "
+          "%.0e)" % (name, len(a), worst, tolerance))
+    return failures
+
+
+def run_scene(binary, text, folder, name, expect_success=True):
+    """Write the scene as folder/name.prm and run it; unless told it may
+    fail, a non-zero exit ends the test with the run's output."""
+    scene = os.path.join(folder, name + ".prm")
+    with open(scene, "w") as f:
+        f.write(text)
+    result = subprocess.run([binary, scene], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    if expect_success and result.returncode != 0:
+        print(result.stdout[-3000:], result.stderr)
+        raise SystemExit("%s: exit code %d" % (name, result.returncode))
+    return result
+
+
+def run(binary, text, folder, name, expect_success=True):
+    """run_scene(); its summary.json if it must succeed, else the run."""
+    result = run_scene(binary, text, folder, name, expect_success)
+    if not expect_success:
+        return result
+    with open(os.path.join(folder, name, "summary.json")) as f:
+        summary = json.load(f)
+    summary["stdout"] = result.stdout
+    return summary
+
+
+def rotation(angle):
+    """Rodrigues' rotation about (1, 2, 3) / sqrt(14), as the .geo has it."""
+    a = [1 / math.sqrt(14), 2 / math.sqrt(14), 3 / math.sqrt(14)]
+    c, s = math.cos(angle), math.sin(angle)
+    cross = [[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]]
+    return [[c * (i == j) + s * cross[i][j] + (1 - c) * a[i] * a[j]
+             for j in range(3)] for i in range(3)]
+
+
+def stack(load, folder, name, pairing="mortar", mu=0.5, lower=4, upper=3,
+          angle=0.0, n_interfaces=1):
+    tx, ty, tz = load
+    # The tilted stack's slip across its force stalls at 2.5e-9 of the
+    # displacements (the accelerated angles are at round-off): 1e-8 there.
+    tolerance = 1e-10 if angle == 0 else 1e-8
+    return STACK.format(
+        mesh=os.path.join(MESHES, "contact_stack_3d.geo"), lower=lower,
+        upper=upper, angle=angle, materials=MATERIALS, bottom=3, top=4,
+        tx=tx, ty=ty, tz=tz, n_interfaces=n_interfaces, tolerance=tolerance,
+        interface=INTERFACE.format(pairing=pairing, mu=mu)
+        if n_interfaces else "",
+        folder=os.path.join(folder, name))
+
+
+def balance(summary, load):
+    """|force on the slave + load|_inf / |load|_inf."""
+    interface = summary["contact_interfaces"]["block"]
+    total = [interface["force_on_slave"][d] +
+             interface["tangential_force_on_slave"][d] + load[d]
+             for d in range(3)]
+    return max(abs(x) for x in total) / max(abs(x) for x in load), interface
+
+
+def iterations(summary):
+    found = re.findall(r"friction iteration\s+(\d+)", summary["stdout"])
+    return int(found[-1]) if found else 0
+
+
+def main():
+    binary = os.path.abspath(sys.argv[1])
+    failures = 0
+    with tempfile.TemporaryDirectory() as folder:
+        # 1. mu = 0.
+        for scene, tolerance in FRICTIONLESS:
+            text = open(os.path.join(SCENES, scene)).read()
+            text = re.sub(r"(set File\s*=\s*)(\S+)",
+                          lambda m: m.group(1) + os.path.normpath(
+                              os.path.join(SCENES, m.group(2))), text)
+            name = scene[:-4]
+            text = re.sub(r"\n\s*set Solver\s*=.*", "", text)
+            text = text.replace("subsection Contact",
+                                "subsection Contact\n  set Solver = sparse", 1)
+            plain = run(binary, with_output(text, os.path.join(folder, name)),
+                        folder, name)
+            frictional = re.sub(
+                r"(\n(\s*)subsection Interface \d+)",
+                lambda m: m.group(1) + "\n" + m.group(2) +
+                "  set Friction = coulomb\n" + m.group(2) +
+                "  set Friction coefficient = 0", text)
+            assert frictional != text
+            other = run(binary,
+                        with_output(frictional,
+                                    os.path.join(folder, name + "_mu0")),
+                        folder, name + "_mu0")
+            del plain["stdout"], other["stdout"]
+            failures += compare(name + ", mu = 0", plain, other, tolerance)
+
+        # 2. Very large mu against the bonded box.
+        load = (5e4, 2.5e4, -1e6)
+        bonded_text = stack(load, folder, "bonded", n_interfaces=0)
+        bonded_text = re.sub(
+            r"set File .*\n.*\n.*\n",
+            "set File = %s\n  set Gmsh arguments = -setnumber hex 1 "
+            "-setnumber n 2 -setnumber two 1\n"
+            % os.path.join(MESHES, "block.geo"), bonded_text)
+        # block.geo's bottom and top are 5 and 6.
+        bonded_text = bonded_text.replace("Boundary ids = 3", "Boundary ids "
+                                          "= 5").replace("Boundary ids = 4",
+                                                         "Boundary ids = 6")
+        bonded = run(binary, bonded_text, folder, "bonded")
+        sticking = run(binary, stack(load, folder, "sticking",
+                                     pairing="node-to-node", mu=1e3,
+                                     lower=2, upper=2), folder, "sticking")
+        assert sticking["contact_interfaces"]["block"]["n_slip"] == 0
+        for key in ("energy", "max_displacement"):
+            error = abs(sticking[key] - bonded[key]) / abs(bonded[key])
+            print("mu = 1e3 against bonded: %s %.1e (tolerance 1e-10)"
+                  % (key, error))
+            failures += error > 1e-10
+        reaction = sticking["reactions"]["3"]
+        reference = bonded["reactions"]["5"]
+        reaction = reaction if isinstance(reaction, list) else \
+            reaction["force"]
+        reference = reference if isinstance(reference, list) else \
+            reference["force"]
+        error = max(abs(x - y) for x, y in zip(reaction, reference)) / \
+            max(abs(x) for x in reference)
+        print("mu = 1e3 against bonded: reaction %.1e (tolerance 1e-10)"
+              % error)
+        failures += error > 1e-10
+
+        # 3. and 4. Statics of the upper cube held by friction, the stack
+        # level and tilted.
+        G, r, skew = 1e6, 0.2, 0.3
+        for angle, mu, ratios in ((0.0, 0.5, (r,)),
+                                  (0.7, 0.3, (0.8 * 0.3, 1.2 * 0.3))):
+            R = rotation(angle)
+            for ratio in ratios:
+                local = (ratio * G * math.cos(skew), ratio * G * math.sin(skew),
+                         -G)
+                load = tuple(sum(R[i][j] * local[j] for j in range(3))
+                             for i in range(3))
+                for pairing in ("node-to-segment", "mortar"):
+                    name = "statics_%g_%g_%s" % (angle, ratio, pairing)
+                    if ratio < mu:
+                        summary = run(binary, stack(
+                            load, folder, name, pairing=pairing, mu=mu,
+                            angle=angle), folder, name)
+                        error, interface = balance(summary, load)
+                        print("angle %g, %s, mu = %g > %.3f: interface force "
+                              "+ load relative %.1e (tolerance 1e-8); %d "
+                              "sticking, %d slipping, %d iterations"
+                              % (angle, pairing, mu, ratio, error,
+                                 interface["n_stick"], interface["n_slip"],
+                                 iterations(summary)))
+                        failures += error > 1e-8
+                    # Below the ratio (the level stack at mu = 0.1, the
+                    # tilted one at 1.03 mu): refused, naming it.
+                    weak = 0.1 if angle == 0 else mu
+                    if ratio < weak:
+                        continue
+                    refused = run(binary, stack(
+                        load, folder, name + "_slides", pairing=pairing,
+                        mu=weak, angle=angle), folder, name + "_slides",
+                        expect_success=False)
+                    lines = refused.stderr.strip().splitlines()
+                    named = "tangential/normal force %.3g)" % ratio
+                    ok = (refused.returncode == 1 and len(lines) == 1 and
+                          "friction cannot hold it" in lines[0] and
+                          named in lines[0])
+                    print("angle %g, %s, mu = %g < %.3f: exit %d, %s (%s)" %
+                          (angle, pairing, weak, ratio, refused.returncode,
+                           "names the ratio" if ok else "WRONG",
+                           lines[-1] if lines else ""))
+                    failures += not ok
+    print("PASS" if failures == 0 else "FAIL: %d checks" % failures)
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
