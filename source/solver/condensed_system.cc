@@ -71,17 +71,28 @@ namespace knee_contact
      * S~ = S + rho B^T B (B: every pair's row), W = S~^-1 B^T (k x P),
      * G = B W (P x P), and per load case u0 = S~^-1 f and h = B u0.
      */
-    bool                      multiplier_loop = false;
-    std::vector<unsigned int> row_pairs;
-    double                    rho = 0;
-    std::vector<double>       s_tilde;
-    std::vector<double>       w;
-    std::vector<double>       g;
-    std::vector<double>       u0;
-    std::vector<double>       h;
+    bool multiplier_loop = false;
+    /** Whether the measured-only rows join it (once springs are set). */
+    bool                               measured_in_loop = false;
+    std::vector<ContactSystem::Spring> springs;
+    std::vector<unsigned int>          row_pairs;
+    double                             rho = 0;
+    std::vector<double>                s_tilde;
+    std::vector<double>                w;
+    std::vector<double>                g;
+    std::vector<double>                u0;
+    std::vector<double>                h;
 
     void
     set_up_multiplier_loop();
+
+    /** u0 = S~^-1 f and h = B u0 of the current load case. */
+    void
+    load_multiplier_loop();
+
+    /** A spring's w over the contact unknowns and its g_w. */
+    std::pair<std::vector<std::pair<unsigned int, double>>, double>
+    spring_row(const ContactSystem::Spring &spring) const;
 
     bool
     solve_by_multipliers(const std::vector<bool> &active);
@@ -225,7 +236,7 @@ namespace knee_contact
     row_pairs.clear();
     for (unsigned int p = 0; p < pairs.size(); ++p)
       if (pairs[p].eliminated != numbers::invalid_dof_index &&
-          !pairs[p].measured_only)
+          (!pairs[p].measured_only || measured_in_loop))
         row_pairs.push_back(p);
     const std::size_t n_rows = row_pairs.size();
     if (k == 0 || n_rows == 0)
@@ -298,6 +309,45 @@ namespace knee_contact
           {
             z[q] = h[q];
             m[q * n_rows + q] -= 1. / rho;
+          }
+      }
+    // A spring k on w = sum_i c_i b_i (rows never active): their z_i must
+    // give -rho b_i x + k c_i (w x - g_w), so with M = rho I - k c c^T
+    // over its rows, M (G z)_i - z_i = M h_i + k g_w c_i (each row of an
+    // inactive row's equation times rho, where M = rho I).
+    if (!springs.empty())
+      {
+        std::vector<int> q_of(pairs.size(), -1);
+        for (std::size_t q = 0; q < n_rows; ++q)
+          q_of[row_pairs[q]] = q;
+        for (const auto &spring : springs)
+          {
+            double g_w = 0;
+            for (const auto &[r, c] : spring.rows)
+              {
+                AssertThrow(q_of[r] >= 0 && !active[r], ExcInternalError());
+                g_w += c * pairs[r].reduced_gap;
+              }
+            for (const auto &[r_i, c_i] : spring.rows)
+              {
+                const std::size_t q_i = q_of[r_i];
+                for (std::size_t column = 0; column < n_rows; ++column)
+                  {
+                    double sum = 0;
+                    for (const auto &[r_j, c_j] : spring.rows)
+                      sum += ((r_i == r_j ? rho : 0.) -
+                              spring.stiffness * c_i * c_j) *
+                             g[column * n_rows + q_of[r_j]];
+                    m[column * n_rows + q_i] = sum;
+                  }
+                m[q_i * n_rows + q_i] -= 1;
+                double right = spring.stiffness * g_w * c_i;
+                for (const auto &[r_j, c_j] : spring.rows)
+                  right +=
+                    ((r_i == r_j ? rho : 0.) - spring.stiffness * c_i * c_j) *
+                    h[q_of[r_j]];
+                z[q_i] = right;
+              }
           }
       }
     const types::blas_int        n = n_rows, one = 1;
@@ -386,20 +436,67 @@ namespace knee_contact
     for (std::size_t j = 0; j < k; ++j)
       for (std::size_t i = j; i < k; ++i)
         d.f[i] += d.l_cc[j * k + i] * d.forward[n - k + j];
-    if (d.multiplier_loop)
-      {
-        d.u0                      = d.f;
-        const types::blas_int n_k = k, one = 1;
-        types::blas_int       info = 0;
-        potrs(
-          "L", &n_k, &one, d.s_tilde.data(), &n_k, d.u0.data(), &n_k, &info);
-        AssertThrow(info == 0, ExcInternalError());
-        d.h.assign(d.row_pairs.size(), 0.);
-        for (std::size_t q = 0; q < d.row_pairs.size(); ++q)
-          for (const auto &[l, a] : d.rows[d.row_pairs[q]])
-            d.h[q] += a * d.u0[l];
-      }
+    d.load_multiplier_loop();
     d.timings.condensation += clock.wall_time();
+  }
+
+
+
+  void
+  CondensedContactSystem::Implementation::load_multiplier_loop()
+  {
+    if (!multiplier_loop)
+      return;
+    const std::size_t k       = dofs.size();
+    u0                        = f;
+    const types::blas_int n_k = k, one = 1;
+    types::blas_int       info = 0;
+    potrs("L", &n_k, &one, s_tilde.data(), &n_k, u0.data(), &n_k, &info);
+    AssertThrow(info == 0, ExcInternalError());
+    h.assign(row_pairs.size(), 0.);
+    for (std::size_t q = 0; q < row_pairs.size(); ++q)
+      for (const auto &[l, a] : rows[row_pairs[q]])
+        h[q] += a * u0[l];
+  }
+
+
+
+  std::pair<std::vector<std::pair<unsigned int, double>>, double>
+  CondensedContactSystem::Implementation::spring_row(
+    const ContactSystem::Spring &spring) const
+  {
+    std::map<unsigned int, double> w;
+    double                         gap = 0;
+    for (const auto &[r, c] : spring.rows)
+      {
+        for (const auto &[l, a] : rows[r])
+          w[l] += c * a;
+        gap += c * pairs[r].reduced_gap;
+      }
+    return {{w.begin(), w.end()}, gap};
+  }
+
+
+
+  void
+  CondensedContactSystem::set_springs(const std::vector<Spring> &springs)
+  {
+    Implementation &d = *implementation;
+    d.springs         = springs;
+    // The first springs: their rows (measured only so far) join the
+    // multiplier loop, set up again on S.
+    if (!springs.empty() && d.multiplier_loop && !d.measured_in_loop)
+      {
+        Timer clock;
+        d.measured_in_loop = true;
+        d.multiplier_loop  = false;
+        d.s = product_with_transpose(d.l_cc, d.dofs.size(), d.shift);
+        d.set_up_multiplier_loop();
+        if (d.multiplier_loop)
+          std::vector<double>().swap(d.s);
+        d.load_multiplier_loop();
+        d.timings.loop_setup += clock.wall_time();
+      }
   }
 
 
@@ -412,6 +509,23 @@ namespace knee_contact
     const std::size_t k = d.dofs.size();
     if (s.empty())
       s = product_with_transpose(l_cc, k, shift);
+    // The springs' k w w^T on S and k g_w w on f, for this solve.
+    std::vector<double> s_saved, f_saved;
+    if (!springs.empty())
+      {
+        s_saved = s;
+        f_saved = f;
+        for (const auto &spring : springs)
+          {
+            const auto [w, g_w] = spring_row(spring);
+            for (const auto &[i, a_i] : w)
+              {
+                f[i] += spring.stiffness * g_w * a_i;
+                for (const auto &[j, a_j] : w)
+                  s[std::size_t(j) * k + i] += spring.stiffness * a_i * a_j;
+              }
+          }
+      }
     // The active rows, each solved for its eliminated dof, as constraints
     // on the local indices; close() resolves chains (a row whose
     // eliminated dof another row refers to), as in the full path.
@@ -492,6 +606,11 @@ namespace knee_contact
         for (const auto &[a, c] : t_of[l])
           d.x_c[l] += c * y[a];
       }
+    if (!springs.empty())
+      {
+        s.swap(s_saved);
+        f.swap(f_saved);
+      }
   }
 
 
@@ -520,6 +639,16 @@ namespace knee_contact
     Vector<double> residual(d.matrix.m());
     for (unsigned int i = 0; i < k; ++i)
       residual(d.dofs[i]) = d.f[i] - (s_x[i] - d.shift * d.x_c[i]);
+    // Less the springs' forces k (w x - g_w) w.
+    for (const auto &spring : d.springs)
+      {
+        const auto [w, g_w] = d.spring_row(spring);
+        double stretch      = -g_w;
+        for (const auto &[i, a] : w)
+          stretch += a * d.x_c[i];
+        for (const auto &[i, a] : w)
+          residual(d.dofs[i]) -= spring.stiffness * stretch * a;
+      }
     lambda = ActiveSetSolver::multipliers(residual,
                                           AffineConstraints<double>(),
                                           d.pairs,

@@ -182,8 +182,11 @@ namespace knee_contact
     std::vector<TangentialVector> slip_force(n, TangentialVector{});
     // 3D: the slip directions' fixed point, accelerated (see below).
     DirectionAcceleration acceleration;
-    unsigned int          n_let_go  = 0;
-    bool                  sets_held = false;
+    unsigned int          n_let_go = 0;
+    // 3D on a path that takes springs: the semismooth Newton step.
+    const bool          newton = dim == 3 && system.takes_springs();
+    std::vector<double> spring_k(n, 0.);
+    bool                sets_held = false;
     // What the bodies need of friction, measured while everything sticks
     // (the first iteration): per interface the sum of the tangential forces
     // (Cartesian) and of lambda_n.
@@ -228,6 +231,7 @@ namespace knee_contact
               if (in_contact_in(active, p))
                 set_state(active, p, true, can_stick(p));
             slip_force.assign(n, TangentialVector{});
+            spring_k.assign(n, 0.);
             seen.clear();
           }
         else if (!free.empty())
@@ -258,6 +262,31 @@ namespace knee_contact
               for (const auto &[dof, a] : rows[at.tangential(j, p)].row)
                 load(dof) -= slip_force[p][j] * a;
         system.set_rhs(load);
+        // The semismooth Newton step (3D, where the path takes springs):
+        // each slipping pair's force bound d is linearised in its slip,
+        // lambda_t = bound d + k (I - d d^T) s, a spring k across d on its
+        // tangential rows (k = c_s bound / |lambda_t + c_s s| of the
+        // iteration that set it slipping: bound / |s| while it slips on).
+        if (newton)
+          {
+            std::vector<ContactSystem::Spring> springs;
+            for (unsigned int p = 0; p < n; ++p)
+              if (active[p] && spring_k[p] > 0 &&
+                  magnitude(slip_force[p]) > 0 &&
+                  rows[at.tangential(0, p)].eliminated !=
+                    numbers::invalid_dof_index &&
+                  rows[at.tangential(1, p)].eliminated !=
+                    numbers::invalid_dof_index)
+                {
+                  const double          f = magnitude(slip_force[p]);
+                  ContactSystem::Spring spring;
+                  spring.rows = {{at.tangential(0, p), -slip_force[p][1] / f},
+                                 {at.tangential(1, p), slip_force[p][0] / f}};
+                  spring.stiffness = spring_k[p];
+                  springs.push_back(spring);
+                }
+            system.set_springs(springs);
+          }
         system.solve(active, excess, lambda);
         // lambda_n and lambda_t of each pair: of a sticking pair from the
         // multipliers of its stick rows (stick_coefficients()).
@@ -315,6 +344,7 @@ namespace knee_contact
 
         std::vector<bool>             next(at.size(), false);
         std::vector<TangentialVector> next_force(n, TangentialVector{});
+        std::vector<double>           next_spring_k(n, 0.);
         std::vector<TangentialVector> proposed_direction(n, TangentialVector{});
         result.complementarity    = 0;
         result.max_penetration    = -std::numeric_limits<double>::max();
@@ -391,8 +421,10 @@ namespace knee_contact
                 stick              = along < 0;
                 // What the slip has across its force (zero at the
                 // solution: the force opposes the slip).
+                // (Not sqrt(|s|^2 - along^2): that cancels to
+                // sqrt(eps) |s|.)
                 const double across =
-                  std::sqrt(std::max(0., s_norm * s_norm - along * along));
+                  std::abs(direction[0] * s[1] - direction[1] * s[0]);
                 // (Without a bound, any slip satisfies the law.)
                 if (bound > 0)
                   result.complementarity =
@@ -414,8 +446,11 @@ namespace knee_contact
                       {bound * direction[0] + ct * s[0],
                        bound * direction[1] + ct * s[1]}};
                     stick = magnitude(v) <= bound;
+                    // With the Newton step the slip's own direction, else
+                    // v's (a damped fixed point).
                     if (!stick)
-                      proposed_direction[p] = direction = unit(v);
+                      proposed_direction[p] = direction =
+                        newton && s_norm > 0 ? unit(s) : unit(v);
                   }
                 else if (!stick && s_norm > 0)
                   proposed_direction[p] = direction = unit(s);
@@ -425,8 +460,17 @@ namespace knee_contact
             if (stick)
               ++n_stick;
             else
-              for (unsigned int j = 0; j + 1 < dim; ++j)
-                next_force[p][j] = component(direction[j] * bound);
+              {
+                for (unsigned int j = 0; j + 1 < dim; ++j)
+                  next_force[p][j] = component(direction[j] * bound);
+                if (newton)
+                  {
+                    const double c_s = c * rows[p].spacing(dim);
+                    const double v   = magnitude(TangentialVector{
+                      {t_force[0] + c_s * s[0], t_force[1] + c_s * s[1]}});
+                    next_spring_k[p] = v > 0 ? c_s * bound / v : 0.;
+                  }
+              }
             const TangentialVector change{
               {next_force[p][0] - slip_force[p][0],
                next_force[p][1] - slip_force[p][1]}};
@@ -438,7 +482,7 @@ namespace knee_contact
         // elastic response to turning the force (near the stick zone): it
         // is accelerated (Anderson mixing, the multisecant form of Newton's
         // method on the angles).
-        if (dim == 3)
+        if (dim == 3 && !newton)
           {
             std::vector<unsigned int> slipping;
             for (unsigned int p = 0; p < n; ++p)
@@ -541,6 +585,7 @@ namespace knee_contact
         seen.insert({active, slip_force});
         active     = next;
         slip_force = next_force;
+        spring_k   = next_spring_k;
       }
   }
 } // namespace knee_contact

@@ -79,6 +79,33 @@ namespace knee_contact
       (void)relative;
     }
 
+    /**
+     * A spring of stiffness k [N/m^2 in 2D, N/m in 3D] on a combination
+     * w = sum_r c_r a_r of rows (energy 1/2 k (w x - g_w)^2,
+     * g_w = sum_r c_r g_r): the tangential Jacobian of a slipping
+     * frictional pair, k (I - d d^T) in its tangent plane, for the
+     * semismooth Newton step of ActiveSetSolver::solve_with_friction().
+     */
+    struct Spring
+    {
+      std::vector<std::pair<unsigned int, double>> rows;
+      double                                       stiffness = 0;
+    };
+
+    /** Whether set_springs() is served; else the loop does without. */
+    virtual bool
+    takes_springs() const
+    {
+      return false;
+    }
+
+    /** The springs of the following solves (none by default). */
+    virtual void
+    set_springs(const std::vector<Spring> &springs)
+    {
+      AssertThrow(springs.empty(), ExcInternalError());
+    }
+
     /** Whether the last solve met the final tolerance. */
     virtual bool
     last_solve_exact() const
@@ -197,6 +224,20 @@ namespace knee_contact
      */
     void
     set_rhs(const Vector<double> &rhs) override;
+
+    /**
+     * Springs enter the dense loop: the rows they combine join the
+     * multiplier system (from the first spring on, which sets it up
+     * again), or S before the elimination.
+     */
+    bool
+    takes_springs() const override
+    {
+      return true;
+    }
+
+    void
+    set_springs(const std::vector<Spring> &springs) override;
 
     void
     solve(const std::vector<bool> &active,
