@@ -312,9 +312,10 @@ namespace knee_contact
           }
       }
     // A spring k on w = sum_i c_i b_i (rows never active): their z_i must
-    // give -rho b_i x + k c_i (w x - g_w), so with M = rho I - k c c^T
-    // over its rows, M (G z)_i - z_i = M h_i + k g_w c_i (each row of an
-    // inactive row's equation times rho, where M = rho I).
+    // give -rho b_i x + k c_i (w x - g_w), so with M = I - k/rho c c^T
+    // over its rows, M (G z)_i - z_i / rho = M h_i + k/rho g_w c_i (an
+    // inactive row's equation where k = 0, scaled alike: rows scaled by
+    // rho cost the LU digits, 1e-9 of the forces on a sliding block).
     if (!springs.empty())
       {
         std::vector<int> q_of(pairs.size(), -1);
@@ -335,17 +336,17 @@ namespace knee_contact
                   {
                     double sum = 0;
                     for (const auto &[r_j, c_j] : spring.rows)
-                      sum += ((r_i == r_j ? rho : 0.) -
-                              spring.stiffness * c_i * c_j) *
+                      sum += ((r_i == r_j ? 1. : 0.) -
+                              spring.stiffness / rho * c_i * c_j) *
                              g[column * n_rows + q_of[r_j]];
                     m[column * n_rows + q_i] = sum;
                   }
-                m[q_i * n_rows + q_i] -= 1;
-                double right = spring.stiffness * g_w * c_i;
+                m[q_i * n_rows + q_i] -= 1. / rho;
+                double right = spring.stiffness / rho * g_w * c_i;
                 for (const auto &[r_j, c_j] : spring.rows)
-                  right +=
-                    ((r_i == r_j ? rho : 0.) - spring.stiffness * c_i * c_j) *
-                    h[q_of[r_j]];
+                  right += ((r_i == r_j ? 1. : 0.) -
+                            spring.stiffness / rho * c_i * c_j) *
+                           h[q_of[r_j]];
                 z[q_i] = right;
               }
           }

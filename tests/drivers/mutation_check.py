@@ -45,6 +45,9 @@ EXEMPT = [
      "the whole interface slips: statics fix the normal force G L and the "
      "friction force mu G L for any E and nu and any push that makes every "
      "pair slip"),
+    ("friction_sliding_block_3d.prm",
+     r"^(E|nu):|Condition 2: displacement",
+     "as friction_sliding_block.prm, in 3D"),
     ("uniaxial_block.prm", r"^geometry:",
      "homogeneous strain under a traction: u = eps x holds on a block of "
      "any size, so scaling the block cannot change the answer"),
