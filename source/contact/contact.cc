@@ -1,5 +1,6 @@
 #include <knee_contact/contact/contact.h>
 #include <knee_contact/contact/contact_sides.h>
+#include <knee_contact/contact/face_geometry.h>
 #include <knee_contact/core/input.h>
 
 #include <deal.II/lac/vector.h>
@@ -8,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 
 namespace knee_contact
@@ -395,6 +397,11 @@ namespace knee_contact
                                   " ('" + interface.name + "'): ";
         AssertThrow(!sides.slaves.empty() && !sides.master_faces.empty(),
                     ExcMessage(where + "a side has no faces"));
+        // The master faces by place, for the common normals of 3D
+        // frictional rows.
+        std::optional<ContactSearch<dim>> search;
+        if (dim == 3 && friction)
+          search.emplace(master_face_search(sides));
         ContactPairs<dim> rows =
           interface.pairing == Pairing::mortar
             ? mortar_rows<dim>(sides, interface, i, where)
@@ -440,16 +447,37 @@ namespace knee_contact
                   }
                 else
                   {
-                    // Any tangent: the axis least along n, made orthogonal.
+                    // The common normal m = n - n_master (the master's
+                    // normal where n meets it, else n alone), as in 2D;
+                    // two orthonormal tangents of it, the first along the
+                    // axis least along m.
+                    const MasterHit<3> hit =
+                      master_along_normal(sides,
+                                          *search,
+                                          rows.points[p].position,
+                                          n,
+                                          pair.spacing(dim),
+                                          interface.maximum_gap);
+                    Tensor<1, dim> m = n;
+                    if (hit.face != nullptr)
+                      {
+                        const auto d =
+                          face_geometry::tangents(*hit.face, hit.xi);
+                        Tensor<1, dim> n_master = cross_product_3d(d[0], d[1]);
+                        if (n_master * hit.face->normal < 0)
+                          n_master *= -1;
+                        m -= n_master / n_master.norm();
+                      }
+                    m /= m.norm();
                     unsigned int least = 0;
                     for (unsigned int d = 1; d < dim; ++d)
-                      if (std::abs(n[d]) < std::abs(n[least]))
+                      if (std::abs(m[d]) < std::abs(m[least]))
                         least = d;
                     Tensor<1, dim> e;
                     e[least] = 1;
-                    t[0]     = e - (e * n) * n;
+                    t[0]     = e - (e * m) * m;
                     t[0] /= t[0].norm();
-                    t[1] = cross_product_3d(n, t[0]);
+                    t[1] = cross_product_3d(m, t[0]);
                   }
               }
             // Eliminate the free slave component with the largest
@@ -550,6 +578,12 @@ namespace knee_contact
                           largest              = std::abs(a);
                           component.eliminated = dof;
                         }
+                    // No free slave component (a slave vertex on a
+                    // symmetry plane that Gamma_o holds along e_k): the
+                    // pair cannot stick unless the row is left with
+                    // nothing (held_by_conditions()). Eliminating a master
+                    // dof instead made the loop cycle on a half model of
+                    // two spheres (measured): a full model is the remedy.
                     if (component.eliminated != numbers::invalid_dof_index)
                       taken.insert(component.eliminated);
                     pairs.stick[k].push_back(std::move(component));

@@ -158,6 +158,42 @@ namespace knee_contact
 
 
 
+  MasterHit<3>
+  master_along_normal(const ContactSides<3>  &sides,
+                      const ContactSearch<3> &search,
+                      const Point<3>         &position,
+                      const Tensor<1, 3>     &n,
+                      const double            h,
+                      const double            maximum_gap)
+  {
+    using Face = ContactSides<3>::Face;
+    MasterHit<3> hit;
+    for (const unsigned int m :
+         search.near(BoundingBox<3>(std::vector<Point<3>>{position}),
+                     position,
+                     2 * h,
+                     maximum_gap))
+      {
+        const Face &master = sides.master_faces[m];
+        if (master.normal * n >= 0)
+          continue;
+        Point<2> xi;
+        double   s = 0;
+        if (!node_to_segment_3d::intersect(master, position, n, xi, s) ||
+            !face_geometry::inside(master, xi, 1e-10) || s < -2 * h)
+          continue;
+        if (std::abs(s) < std::abs(hit.s))
+          {
+            hit.s    = s;
+            hit.xi   = xi;
+            hit.face = &master;
+          }
+      }
+    return hit;
+  }
+
+
+
   template <>
   ContactPairs<3>
   node_to_segment_rows(const ContactSides<3>  &sides,
@@ -177,30 +213,9 @@ namespace knee_contact
           continue;
         const Tensor<1, 3> n = slave.unit_normal();
         // The vertex's spacing: the side of a square of its area share.
-        const double h = std::sqrt(slave.length);
-        MasterHit<3> hit;
-        for (const unsigned int m :
-             search.near(BoundingBox<3>(std::vector<Point<3>>{slave.position}),
-                         slave.position,
-                         2 * h,
-                         interface.maximum_gap))
-          {
-            const Face &master = sides.master_faces[m];
-            if (master.normal * n >= 0)
-              continue;
-            Point<2> xi;
-            double   s = 0;
-            if (!node_to_segment_3d::intersect(
-                  master, slave.position, n, xi, s) ||
-                !face_geometry::inside(master, xi, 1e-10) || s < -2 * h)
-              continue;
-            if (std::abs(s) < std::abs(hit.s))
-              {
-                hit.s    = s;
-                hit.xi   = xi;
-                hit.face = &master;
-              }
-          }
+        const double h   = std::sqrt(slave.length);
+        MasterHit<3> hit = master_along_normal(
+          sides, search, slave.position, n, h, interface.maximum_gap);
         const auto no_coincident_vertex = [&]() {
           return ExcMessage(where + "node-to-node pairing: slave vertex at " +
                             point_text(slave.position) +

@@ -23,23 +23,17 @@ namespace knee_contact
 {
   namespace
   {
-    /** a - b as an angle in (-pi, pi]. */
-    double
-    angle_difference(const double a, const double b)
-    {
-      return std::remainder(a - b, 2 * M_PI);
-    }
 
     /**
      * Anderson mixing (Walker and Ni, SIAM J. Numer. Anal. 2011) of the
-     * fixed point x = G(x) on the slipping pairs' force angles: from the
+     * fixed point x = G(x) on the slipping pairs' forces: from the
      * last few iterates x_i and residuals f_i = G(x_i) - x_i, the step
      * x + f - (dX + dF) gamma with gamma minimising |f - dF gamma|. The
      * history restarts whenever the set of slipping pairs changes. Written
      * here: no library at hand mixes a fixed point that is a whole solve
      * of this loop.
      */
-    class DirectionAcceleration
+    class SlipForceAcceleration
     {
     public:
       std::vector<double>
@@ -50,7 +44,7 @@ namespace knee_contact
         const std::size_t   m = x.size();
         std::vector<double> f(m);
         for (std::size_t i = 0; i < m; ++i)
-          f[i] = angle_difference(g[i], x[i]);
+          f[i] = g[i] - x[i];
         if (pairs != members)
           {
             members = pairs;
@@ -62,7 +56,7 @@ namespace knee_contact
             std::vector<double> step(m), change(m);
             for (std::size_t i = 0; i < m; ++i)
               {
-                step[i]   = angle_difference(x[i], last_x[i]);
+                step[i]   = x[i] - last_x[i];
                 change[i] = f[i] - last_f[i];
               }
             dx.push_back(step);
@@ -143,8 +137,10 @@ namespace knee_contact
     const auto can_stick = [&](const unsigned int p) {
       if (bounds[p].value <= 0)
         return false;
+      // Every stick row can hold, or the conditions hold it already.
       for (unsigned int k = 0; k < dim; ++k)
-        if (rows[at.stick(k, p)].eliminated == numbers::invalid_dof_index)
+        if (rows[at.stick(k, p)].eliminated == numbers::invalid_dof_index &&
+            !rows[at.stick(k, p)].held_by_conditions())
           return false;
       return true;
     };
@@ -154,11 +150,22 @@ namespace knee_contact
                                const bool         stick) {
       state[at.normal(p)] = contact && !stick;
       for (unsigned int k = 0; k < dim; ++k)
-        state[at.stick(k, p)] = contact && stick;
+        state[at.stick(k, p)] =
+          contact && stick &&
+          rows[at.stick(k, p)].eliminated != numbers::invalid_dof_index;
+    };
+    // Sticking: any of its stick rows active (one the conditions hold is
+    // never active).
+    const auto sticking_in = [&](const std::vector<bool> &state,
+                                 const unsigned int       p) {
+      for (unsigned int k = 0; k < dim; ++k)
+        if (state[at.stick(k, p)])
+          return true;
+      return false;
     };
     const auto in_contact_in = [&](const std::vector<bool> &state,
                                    const unsigned int       p) {
-      return state[at.normal(p)] || state[at.stick(0, p)];
+      return state[at.normal(p)] || sticking_in(state, p);
     };
     // Start with the touching pairs (or those of the guess: the previous
     // load case's contact zone) in contact and sticking: the state in
@@ -181,7 +188,7 @@ namespace knee_contact
     // The prescribed tangential multipliers of the slipping pairs.
     std::vector<TangentialVector> slip_force(n, TangentialVector{});
     // 3D: the slip directions' fixed point, accelerated (see below).
-    DirectionAcceleration acceleration;
+    SlipForceAcceleration acceleration;
     unsigned int          n_let_go = 0;
     // 3D on a path that takes springs: the semismooth Newton step.
     const bool          newton = dim == 3 && system.takes_springs();
@@ -296,7 +303,7 @@ namespace knee_contact
           {
             for (unsigned int j = 0; j + 1 < dim; ++j)
               slip[p][j] = excess[at.tangential(j, p)];
-            if (active[at.stick(0, p)])
+            if (sticking_in(active, p))
               {
                 const auto &c = bounds[p].stick;
                 lambda[p]     = 0;
@@ -345,7 +352,6 @@ namespace knee_contact
         std::vector<bool>             next(at.size(), false);
         std::vector<TangentialVector> next_force(n, TangentialVector{});
         std::vector<double>           next_spring_k(n, 0.);
-        std::vector<TangentialVector> proposed_direction(n, TangentialVector{});
         result.complementarity = 0;
         result.max_penetration = -std::numeric_limits<double>::max();
         double force_change    = 0;
@@ -399,7 +405,7 @@ namespace knee_contact
                 // along t_1.
                 direction = s_norm > 0 ? unit(s) : TangentialVector{{1, 0}};
               }
-            if (active[at.stick(0, p)])
+            if (sticking_in(active, p))
               {
                 const double t_norm = magnitude(t_force);
                 stick               = t_norm <= bound + 1e-12 * force_scale;
@@ -454,11 +460,10 @@ namespace knee_contact
                     // With the Newton step the slip's own direction, else
                     // v's (a damped fixed point).
                     if (!stick)
-                      proposed_direction[p] = direction =
-                        newton && s_norm > 0 ? unit(s) : unit(v);
+                      direction = newton && s_norm > 0 ? unit(s) : unit(v);
                   }
                 else if (!stick && s_norm > 0)
-                  proposed_direction[p] = direction = unit(s);
+                  direction = unit(s);
               }
             stick = stick && can_stick(p);
             set_state(next, p, true, stick);
@@ -484,48 +489,51 @@ namespace knee_contact
                                     std::abs(magnitude(next_force[p]) -
                                              magnitude(slip_force[p])));
           }
-        // 3D: while the sets stay, the slipping pairs' force directions
-        // (angles in their tangent planes) are a fixed point of the rule
-        // above, which converges slowly where the slip is small beside the
-        // elastic response to turning the force (near the stick zone): it
-        // is accelerated (Anderson mixing, the multisecant form of Newton's
-        // method on the angles).
-        if (dim == 3 && !newton)
+        // 3D: while the sets stay, the slipping pairs' forces (2-vectors in
+        // their tangent planes) are a fixed point of the rules above: the
+        // Coulomb bound mu lambda_n of the last iterate, and without the
+        // Newton step the direction too. It converges slowly, or not at
+        // all, where the bound feeds back on itself (Cattaneo-Mindlin on
+        // spheres: the changes grew by 1.16 per iteration) or where the slip
+        // is small beside the elastic response to turning the force: it is
+        // accelerated (Anderson mixing, the multisecant form of Newton's
+        // method on the forces).
+        if (dim == 3)
           {
             std::vector<unsigned int> slipping;
             for (unsigned int p = 0; p < n; ++p)
               if (next[p] && active[p] && magnitude(slip_force[p]) > 0 &&
-                  magnitude(next_force[p]) > 0 &&
-                  magnitude(proposed_direction[p]) > 0)
+                  magnitude(next_force[p]) > 0)
                 slipping.push_back(p);
             if (next != active || !sets_held)
               slipping.clear();
             sets_held = next == active;
-            std::vector<double> angle(slipping.size()),
-              proposed(slipping.size());
-            for (unsigned int i = 0; i < slipping.size(); ++i)
-              {
-                const auto &now = slip_force[slipping[i]];
-                const auto &to  = proposed_direction[slipping[i]];
-                angle[i]        = std::atan2(now[1], now[0]);
-                proposed[i]     = std::atan2(to[1], to[0]);
-              }
+            std::vector<unsigned int> members;
+            std::vector<double>       now, to;
+            for (const unsigned int p : slipping)
+              for (unsigned int j = 0; j < 2; ++j)
+                {
+                  members.push_back(2 * p + j);
+                  now.push_back(slip_force[p][j]);
+                  to.push_back(next_force[p][j]);
+                }
             const std::vector<double> mixed =
-              acceleration.next(slipping, angle, proposed);
-            force_change = 0;
+              acceleration.next(members, now, to);
             for (unsigned int i = 0; i < slipping.size(); ++i)
-              {
-                auto        &to    = next_force[slipping[i]];
-                const double bound = magnitude(to);
-                to                 = {{component(bound * std::cos(mixed[i])),
-                                       component(bound * std::sin(mixed[i]))}};
-              }
+              for (unsigned int j = 0; j < 2; ++j)
+                next_force[slipping[i]][j] = component(mixed[2 * i + j]);
+            force_change = bound_change = 0;
             for (unsigned int p = 0; p < n; ++p)
-              force_change =
-                std::max(force_change,
-                         magnitude(TangentialVector{
-                           {next_force[p][0] - slip_force[p][0],
-                            next_force[p][1] - slip_force[p][1]}}));
+              {
+                force_change =
+                  std::max(force_change,
+                           magnitude(TangentialVector{
+                             {next_force[p][0] - slip_force[p][0],
+                              next_force[p][1] - slip_force[p][1]}}));
+                bound_change = std::max(bound_change,
+                                        std::abs(magnitude(next_force[p]) -
+                                                 magnitude(slip_force[p])));
+              }
           }
         result.n_iterations = iteration;
         log << "   friction iteration " << std::setw(2) << iteration << ": "
@@ -547,7 +555,7 @@ namespace knee_contact
             {
               result.active[p] = true;
               result.status[p] =
-                active[at.stick(0, p)] ? Status::stick : Status::slip;
+                sticking_in(active, p) ? Status::stick : Status::slip;
               // The slip of a pair in contact (an open pair's tangential
               // jump is no slip).
               if (result.status[p] == Status::slip)

@@ -27,7 +27,7 @@
    naming the ratio 1.2 x 0.3 = 0.36.
 Each held case runs on the automatic path (condensed: the semismooth Newton
 step, 9-10 iterations) and on the sparse one (which takes no springs: the
-accelerated fixed point on the slip directions, 22-67 iterations; the
+Anderson-accelerated fixed point on the slip forces, 19-62 iterations; the
 scenes allow 100); their energy and max |u| agree to 1e-8.
 Usage: friction_3d.py KNEE_CONTACT
 """

@@ -123,6 +123,19 @@ namespace knee_contact
                       const Tensor<1, 2>    &n,
                       const double           length);
 
+  /**
+   * The 3D master hit among the faces @p search finds within 2 @p h (the
+   * slave's spacing) and @p maximum_gap of @p position (node-to-segment
+   * rows; also the common normal of a frictional 3D row).
+   */
+  MasterHit<3>
+  master_along_normal(const ContactSides<3>  &sides,
+                      const ContactSearch<3> &search,
+                      const Point<3>         &position,
+                      const Tensor<1, 3>     &n,
+                      const double            h,
+                      const double            maximum_gap);
+
 
 
   /**

@@ -58,6 +58,19 @@ namespace knee_contact
     bool measured_only = false;
 
     /**
+     * Whether Gamma_u and Gamma_o alone make the row hold (nothing of it
+     * is left after their substitution).
+     */
+    bool
+    held_by_conditions() const
+    {
+      for (const auto &entry : reduced_row)
+        if (std::abs(entry.second) > 1e-12)
+          return false;
+      return true;
+    }
+
+    /**
      * The slave vertex's spacing [m] in a mesh of dimension @p dim: the
      * weight itself in 2D, the square root of the area share in 3D.
      */
