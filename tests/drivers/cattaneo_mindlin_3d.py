@@ -50,11 +50,10 @@ import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
+from cattaneo_mindlin import E, E_STAR, MU, NU, R, check  # noqa: E402
 from friction import run_scene  # noqa: E402
 
 GEO = os.path.normpath(os.path.join(HERE, "..", "meshes", "cattaneo_3d.geo"))
-E, NU, MU, R = 1.0, 0.3, 0.3, 1.0
-E_STAR = E / (2 * (1 - NU**2))
 # Tolerances of the traction [mu p0] from the mesh study.
 BIAS_TOLERANCE = 0.08
 # The loop's limit and Contact/Tolerance (the study: 200 and 1e-8; at
@@ -196,13 +195,6 @@ def measure(binary, folder, h, d):
             "q_rms": q_rms, "n_stick": len(dx),
             "balance": balance, "iterations": iterations,
             "dofs": summary["n_dofs"]}
-
-
-def check(name, value, tolerance, failures):
-    ok = value <= tolerance
-    print("%-58s %.3e <= %.1e: %s" % (name, value, tolerance,
-                                       "PASS" if ok else "FAIL"))
-    return failures + (0 if ok else 1)
 
 
 def main():

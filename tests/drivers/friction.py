@@ -269,17 +269,27 @@ def numbers(value, path=""):
         yield path, float(value)
 
 
-def compare(name, reference, other, tolerance):
+def kind_of(key):
+    """The kind of a summary.json number, the scale of its differences:
+    its top-level entry, every stress one kind (a patch test's zero
+    components are round-off beside the others)."""
+    top = key.split("/")[1]
+    return "stress" if "stress" in top or "mises" in top else top
+
+
+def compare(name, reference, other, tolerance, kind=lambda key:
+            key.split("/")[1]):
+    """Every number of two summaries, relative to the largest of its
+    @p kind in the reference."""
     a, b = dict(numbers(reference)), dict(numbers(other))
     assert a.keys() == b.keys(), (name, a.keys() ^ b.keys())
     worst, failures = 0.0, 0
     for key in a:
-        top = key.split("/")[1]
-        if top in ("equilibrium_residual", "relative_max_penetration",
-                   "complementarity_residual", "max_penetration"):
+        if kind(key) in ("equilibrium_residual", "relative_max_penetration",
+                         "complementarity_residual", "max_penetration"):
             continue  # round-off measures
         scale = max(abs(v) for k, v in a.items()
-                    if k.split("/")[1] == top) or 1.0
+                    if kind(k) == kind(key)) or 1.0
         error = abs(a[key] - b[key]) / scale
         worst = max(worst, error)
         if error > tolerance:
@@ -301,36 +311,45 @@ def with_output(text, folder):
                         "  set Pictures = false" % folder, 1)
 
 
+def mu_zero_runs(binary, folder, scenes, run_one):
+    """For each (scene, tolerance) of tests/scenes: the scene and its copy
+    with Friction = coulomb, Friction coefficient = 0 on every interface,
+    both run by @p run_one on the sparse path (the automatic choice weighs
+    the number of rows, which friction doubles; paths differ by round-off):
+    yields (name, tolerance, frictionless result, frictional result)."""
+    for scene, tolerance in scenes:
+        text = open(os.path.join(SCENES, scene)).read()
+        # Relative paths of the scene (meshes) from the scenes folder.
+        text = re.sub(r"(set File\s*=\s*)(\S+)",
+                      lambda m: m.group(1) + os.path.normpath(
+                          os.path.join(SCENES, m.group(2))), text)
+        name = scene[:-4]
+        text = re.sub(r"\n\s*set Solver\s*=.*", "", text)
+        text = text.replace("subsection Contact",
+                            "subsection Contact\n  set Solver = sparse", 1)
+        plain = run_one(binary,
+                        with_output(text, os.path.join(folder, name)),
+                        folder, name)
+        frictional = re.sub(
+            r"(\n(\s*)subsection Interface \d+)",
+            lambda m: m.group(1) + "\n" + m.group(2) +
+            "  set Friction = coulomb\n" + m.group(2) +
+            "  set Friction coefficient = 0", text)
+        assert frictional != text
+        other = run_one(binary,
+                        with_output(frictional,
+                                    os.path.join(folder, name + "_mu0")),
+                        folder, name + "_mu0")
+        yield name, tolerance, plain, other
+
+
 def main():
     binary = os.path.abspath(sys.argv[1])
     failures = 0
     with tempfile.TemporaryDirectory() as folder:
         # 1. mu = 0.
-        for scene, tolerance in FRICTIONLESS:
-            text = open(os.path.join(SCENES, scene)).read()
-            # Relative paths of the scene (meshes) from the scenes folder.
-            text = re.sub(r"(set File\s*=\s*)(\S+)",
-                          lambda m: m.group(1) + os.path.normpath(
-                              os.path.join(SCENES, m.group(2))), text)
-            name = scene[:-4]
-            # One linear solver path for both (the automatic choice weighs
-            # the number of rows, which friction doubles; paths differ by
-            # round-off).
-            text = re.sub(r"\n\s*set Solver\s*=.*", "", text)
-            text = text.replace("subsection Contact",
-                                "subsection Contact\n  set Solver = sparse", 1)
-            plain = run(binary, with_output(text, os.path.join(folder, name)),
-                        folder, name)
-            frictional = re.sub(
-                r"(\n(\s*)subsection Interface \d+)",
-                lambda m: m.group(1) + "\n" + m.group(2) +
-                "  set Friction = coulomb\n" + m.group(2) +
-                "  set Friction coefficient = 0", text)
-            assert frictional != text
-            other = run(binary,
-                        with_output(frictional,
-                                    os.path.join(folder, name + "_mu0")),
-                        folder, name + "_mu0")
+        for name, tolerance, plain, other in mu_zero_runs(
+                binary, folder, FRICTIONLESS, run):
             failures += compare(name + ", mu = 0", plain, other, tolerance)
 
         # 2. Very large mu against bonded rectangles.

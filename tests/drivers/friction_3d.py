@@ -35,37 +35,20 @@ import json
 import math
 import os
 import re
-import subprocess
 import sys
 import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-SCENES = os.path.join(HERE, "..", "scenes")
 MESHES = os.path.join(HERE, "..", "meshes")
 sys.path.insert(0, HERE)
-from friction import numbers, with_output  # noqa: E402
+from friction import (MATERIALS, compare, kind_of, mu_zero_runs,  # noqa
+                      run_scene)
 
 FRICTIONLESS = [("contact_patch_3d_hex.prm", 1e-12),
                 ("contact_patch_3d_tet.prm", 1e-12),
                 ("contact_patch_3d_matching.prm", 1e-12),
                 ("hertz_sphere_3d_small.prm", 1e-12)]
 
-MATERIALS = """subsection Materials
-  set Number of materials = 2
-  subsection Material 0
-    set Material id     = 1
-    set Name            = base
-    set Young's modulus = 1e9
-    set Poisson's ratio = 0.3
-  end
-  subsection Material 1
-    set Material id     = 2
-    set Name            = block
-    set Young's modulus = 3e9
-    set Poisson's ratio = 0.2
-  end
-end
-"""
 
 # The stack: boundary ids 3 bottom, 4 top, 5 top of the lower cube, 6
 # bottom of the upper one.
@@ -108,48 +91,6 @@ INTERFACE = """  subsection Interface 0
     set Friction             = coulomb
     set Friction coefficient = {mu}
   end"""
-
-
-def compare(name, reference, other, tolerance):
-    """Every number of two summaries, relative to the largest of its kind;
-    the stresses of every kind relative to the largest stress (a patch
-    test's zero components are round-off)."""
-    a, b = dict(numbers(reference)), dict(numbers(other))
-    assert a.keys() == b.keys(), (name, a.keys() ^ b.keys())
-
-    def kind(key):
-        top = key.split("/")[1]
-        return "stress" if "stress" in top or "mises" in top else top
-    worst, failures = 0.0, 0
-    for key in a:
-        if kind(key) in ("equilibrium_residual", "relative_max_penetration",
-                         "complementarity_residual", "max_penetration"):
-            continue  # round-off measures
-        scale = max(abs(v) for k, v in a.items()
-                    if kind(k) == kind(key)) or 1.0
-        error = abs(a[key] - b[key]) / scale
-        worst = max(worst, error)
-        if error > tolerance:
-            print("FAIL %s: %s = %r, reference %r" % (name, key, b[key],
-                                                     a[key]))
-            failures += 1
-    print("%s: %d numbers, largest relative difference %.1e (tolerance "
-          "%.0e)" % (name, len(a), worst, tolerance))
-    return failures
-
-
-def run_scene(binary, text, folder, name, expect_success=True):
-    """Write the scene as folder/name.prm and run it; unless told it may
-    fail, a non-zero exit ends the test with the run's output."""
-    scene = os.path.join(folder, name + ".prm")
-    with open(scene, "w") as f:
-        f.write(text)
-    result = subprocess.run([binary, scene], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
-    if expect_success and result.returncode != 0:
-        print(result.stdout[-3000:], result.stderr)
-        raise SystemExit("%s: exit code %d" % (name, result.returncode))
-    return result
 
 
 def run(binary, text, folder, name, expect_success=True):
@@ -203,29 +144,11 @@ def main():
     failures = 0
     with tempfile.TemporaryDirectory() as folder:
         # 1. mu = 0.
-        for scene, tolerance in FRICTIONLESS:
-            text = open(os.path.join(SCENES, scene)).read()
-            text = re.sub(r"(set File\s*=\s*)(\S+)",
-                          lambda m: m.group(1) + os.path.normpath(
-                              os.path.join(SCENES, m.group(2))), text)
-            name = scene[:-4]
-            text = re.sub(r"\n\s*set Solver\s*=.*", "", text)
-            text = text.replace("subsection Contact",
-                                "subsection Contact\n  set Solver = sparse", 1)
-            plain = run(binary, with_output(text, os.path.join(folder, name)),
-                        folder, name)
-            frictional = re.sub(
-                r"(\n(\s*)subsection Interface \d+)",
-                lambda m: m.group(1) + "\n" + m.group(2) +
-                "  set Friction = coulomb\n" + m.group(2) +
-                "  set Friction coefficient = 0", text)
-            assert frictional != text
-            other = run(binary,
-                        with_output(frictional,
-                                    os.path.join(folder, name + "_mu0")),
-                        folder, name + "_mu0")
+        for name, tolerance, plain, other in mu_zero_runs(
+                binary, folder, FRICTIONLESS, run):
             del plain["stdout"], other["stdout"]
-            failures += compare(name + ", mu = 0", plain, other, tolerance)
+            failures += compare(name + ", mu = 0", plain, other, tolerance,
+                                kind_of)
 
         # 2. Very large mu against the bonded box.
         load = (5e4, 2.5e4, -1e6)
