@@ -232,7 +232,8 @@ namespace knee_contact
                                  : decltype(mesh_input.deck_materials())());
     boundary_conditions.check_parameters();
     contact_interfaces.check_parameters();
-    active_set_solver.check_parameters(materials.max_youngs_modulus());
+    active_set_solver.check_parameters(materials.max_youngs_modulus(),
+                                       materials.min_youngs_modulus());
     load_cases.check_parameters();
     output_writer.check_parameters(scene_file);
     verification.check_parameters();

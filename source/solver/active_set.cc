@@ -95,9 +95,11 @@ namespace knee_contact
 
 
   void
-  ActiveSetSolver::check_parameters(const double max_youngs_modulus)
+  ActiveSetSolver::check_parameters(const double max_youngs_modulus,
+                                    const double min_youngs_modulus)
   {
-    c = c_relative * max_youngs_modulus;
+    c         = c_relative * max_youngs_modulus;
+    e_minimum = min_youngs_modulus;
     AssertThrow(c > 0, ExcMessage("Contact/Active set constant must be > 0"));
   }
 

@@ -127,10 +127,12 @@ namespace knee_contact
 
     /**
      * After parsing: the active-set constant in units of
-     * @p max_youngs_modulus, the stiffness scale of the scene.
+     * @p max_youngs_modulus, the stiffness scale of the scene;
+     * @p min_youngs_modulus scales the 3D friction rule's constant.
      */
     void
-    check_parameters(const double max_youngs_modulus);
+    check_parameters(const double max_youngs_modulus,
+                     const double min_youngs_modulus);
 
     /**
      * How the linear systems of the loop are solved (see ContactSystem).
@@ -286,8 +288,10 @@ namespace knee_contact
   private:
     unsigned int max_iterations = 50;
     /** Active set constant as the scene gives it, in units of E_max. */
-    double         c_relative      = 100;
-    double         c               = 0;
+    double c_relative = 100;
+    double c          = 0;
+    /** The softest material's Young's modulus [Pa]. */
+    double         e_minimum       = 0;
     double         tolerance       = 1e-10;
     bool           safeguard       = true;
     LinearSolver   solver          = LinearSolver::automatic;
