@@ -44,8 +44,6 @@ same tolerances (measured: 0.40 h, 0.049, 0.012, 0.18); the loop's
 iterations are printed (the semismooth Newton step of the condensed path).
 Usage: cattaneo_mindlin_3d.py KNEE_CONTACT [--study]
 """
-import csv
-import json
 import math
 import os
 import re
@@ -54,7 +52,8 @@ import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from cattaneo_mindlin import E, E_STAR, MU, NU, R, check  # noqa: E402
+from cattaneo_mindlin import (E, E_STAR, MU, NU, R, check,  # noqa: E402
+                              read_case)
 from friction import run_scene  # noqa: E402
 
 GEO = os.path.normpath(os.path.join(HERE, "..", "meshes", "cattaneo_3d.geo"))
@@ -143,10 +142,7 @@ def run(binary, folder, name, h, d, fx, lower=True, friction="coulomb",
                        folder, name)
     if "," in t:
         out = os.path.join(out, "case_%03d" % t.count(","))
-    with open(os.path.join(out, "summary.json")) as f:
-        summary = json.load(f)
-    with open(os.path.join(out, "contact_cm.csv")) as f:
-        rows = list(csv.DictReader(f))
+    summary, rows = read_case(out)
     found = re.findall(r"friction iteration\s+(\d+)", result.stdout)
     return summary, rows, int(found[-1]) if found else 0
 
