@@ -1,8 +1,9 @@
-#include <knee_contact/core/input.h>
-#include <knee_contact/core/interruption.h>
-#include <knee_contact/core/memory.h>
+#include <knee_contact/base/input.h>
+#include <knee_contact/base/interruption.h>
+#include <knee_contact/base/memory.h>
+#include <knee_contact/base/parallel.h>
+#include <knee_contact/base/progress.h>
 #include <knee_contact/core/problem.h>
-#include <knee_contact/core/progress.h>
 
 #include <deal.II/base/multithread_info.h>
 
@@ -15,7 +16,8 @@
 
 // knee_contact: unilateral contact between linear elastic bodies in 2D and
 // 3D (the dimension comes from the mesh; friction in 2D).
-// Usage: knee_contact [--dry-run] scene.prm | --help | --print-parameters
+// Usage: [mpirun -np N] knee_contact [--dry-run] scene.prm | --help |
+// --print-parameters
 namespace
 {
   // One line, then leave without the library destructors: with the address
@@ -38,14 +40,26 @@ namespace
     std::_Exit(knee_contact::ExitCode::input_error);
   }
 
+  /** The run; a failure's one-line @p message is printed by the caller. */
   int
-  run(int argc, char **argv);
+  run(int argc, char **argv, std::string &message);
 } // namespace
 
 int
 main(int argc, char **argv)
 {
-  const int code = run(argc, argv);
+  // Under mpirun every rank starts MPI at once; rank 0 alone prints.
+  if (knee_contact::parallel::launched_by_mpirun())
+    {
+      knee_contact::parallel::ensure_initialised();
+      knee_contact::parallel::quiet_other_ranks();
+    }
+  std::string message;
+  int         code = run(argc, argv, message);
+  // Printed once; a rank that failed alone ends the others (30 s after the
+  // failure: the replicated work reaches a failure of the input on every
+  // rank within the same step).
+  code = knee_contact::parallel::finish(code, message, 30.);
   // Under an address-space limit an OpenBLAS worker may be stuck retrying
   // its buffer (see memory::prepare_blas()), and exit() would join it:
   // leave without the exit handlers (the results are on disk, the streams
@@ -63,7 +77,7 @@ main(int argc, char **argv)
 namespace
 {
   int
-  run(int argc, char **argv)
+  run(int argc, char **argv, std::string &message)
   {
     using namespace knee_contact;
     const std::string usage =
@@ -101,9 +115,8 @@ namespace
           }
         if (argc != 2 || argv[1][0] == '-')
           {
-            std::cerr << "knee_contact: error: expected one scene file; see "
-                         "knee_contact --help"
-                      << std::endl;
+            message = "knee_contact: error: expected one scene file; see "
+                      "knee_contact --help";
             return ExitCode::input_error;
           }
         if (scene_dimension(argv[1]) == 3)
@@ -117,8 +130,7 @@ namespace
       {
         std::ostringstream info;
         exc.print_info(info);
-        std::cerr << "knee_contact: error: " << input::one_line(info.str())
-                  << std::endl;
+        message = "knee_contact: error: " + input::one_line(info.str());
         return ExitCode::input_error;
       }
     catch (const std::bad_alloc &)
@@ -133,39 +145,35 @@ namespace
         if (exc.code() == std::errc::resource_unavailable_try_again ||
             exc.code() == std::errc::not_enough_memory)
           out_of_memory();
-        std::cerr << "knee_contact: error: " << input::one_line(exc.what())
-                  << std::endl;
+        message = "knee_contact: error: " + input::one_line(exc.what());
         return ExitCode::input_error;
       }
     catch (const dealii::ExceptionBase &exc)
       {
         std::ostringstream info;
         exc.print_info(info);
-        std::cerr << "knee_contact: internal error (a bug; please report it "
-                     "with the scene file): "
-                  << input::one_line(exc.get_exc_name() + std::string(": ") +
-                                     info.str())
-                  << std::endl;
+        message =
+          "knee_contact: internal error (a bug; please report it "
+          "with the scene file): " +
+          input::one_line(exc.get_exc_name() + std::string(": ") + info.str());
         return ExitCode::internal_error;
       }
     catch (const std::runtime_error &exc)
       {
-        std::cerr << "knee_contact: error: " << input::one_line(exc.what())
-                  << std::endl;
+        message = "knee_contact: error: " + input::one_line(exc.what());
         return ExitCode::input_error;
       }
     catch (const std::exception &exc)
       {
-        std::cerr << "knee_contact: internal error (a bug; please report it "
-                     "with the scene file): "
-                  << input::one_line(exc.what()) << std::endl;
+        message = "knee_contact: internal error (a bug; please report it "
+                  "with the scene file): " +
+                  input::one_line(exc.what());
         return ExitCode::internal_error;
       }
     catch (...)
       {
-        std::cerr << "knee_contact: internal error (a bug; please report it "
-                     "with the scene file): unknown exception"
-                  << std::endl;
+        message = "knee_contact: internal error (a bug; please report it "
+                  "with the scene file): unknown exception";
         return ExitCode::internal_error;
       }
   }

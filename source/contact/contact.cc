@@ -1,7 +1,7 @@
+#include <knee_contact/base/input.h>
 #include <knee_contact/contact/contact.h>
 #include <knee_contact/contact/contact_sides.h>
 #include <knee_contact/contact/face_geometry.h>
-#include <knee_contact/core/input.h>
 
 #include <deal.II/lac/vector.h>
 

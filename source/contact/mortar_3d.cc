@@ -31,10 +31,10 @@
 //
 // The rows are then normalised and D lumped exactly as in 2D (mortar.cc).
 
+#include <knee_contact/base/input.h>
 #include <knee_contact/contact/contact_sides.h>
 #include <knee_contact/contact/face_geometry.h>
 #include <knee_contact/contact/search.h>
-#include <knee_contact/core/input.h>
 
 #include <deal.II/base/quadrature_lib.h>
 

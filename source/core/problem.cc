@@ -1,7 +1,7 @@
-#include <knee_contact/core/input.h>
+#include <knee_contact/base/input.h>
+#include <knee_contact/base/scene_file.h>
 #include <knee_contact/core/problem.h>
-#include <knee_contact/core/scene_file.h>
-#include <knee_contact/mesh/scene_checks.h>
+#include <knee_contact/core/scene_checks.h>
 #include <knee_contact/physics/elasticity.h>
 #include <knee_contact/physics/elements.h>
 #include <knee_contact/physics/rigid_modes.h>

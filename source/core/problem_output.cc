@@ -1,7 +1,7 @@
 // The files of a run: result sets, load cases and the results table
 // (ContactProblem's output, split from problem.cc by job).
+#include <knee_contact/base/progress.h>
 #include <knee_contact/core/problem.h>
-#include <knee_contact/core/progress.h>
 #include <knee_contact/physics/elasticity.h>
 
 #include <deal.II/base/data_out_base.h>

@@ -1,10 +1,10 @@
 // The cycles of a run: mesh, setup, assembly, contact solve and errors per
 // refinement cycle (ContactProblem's orchestration, split from problem.cc
 // by job as ASPECT splits its Simulator).
-#include <knee_contact/core/input.h>
+#include <knee_contact/base/input.h>
+#include <knee_contact/base/progress.h>
 #include <knee_contact/core/problem.h>
-#include <knee_contact/core/progress.h>
-#include <knee_contact/mesh/scene_checks.h>
+#include <knee_contact/core/scene_checks.h>
 #include <knee_contact/physics/elasticity.h>
 #include <knee_contact/physics/rigid_modes.h>
 

@@ -1,6 +1,6 @@
-#include <knee_contact/core/input.h>
-#include <knee_contact/core/interruption.h>
-#include <knee_contact/core/memory.h>
+#include <knee_contact/base/input.h>
+#include <knee_contact/base/interruption.h>
+#include <knee_contact/base/memory.h>
 #include <knee_contact/mesh/gmsh_input.h>
 #include <knee_contact/mesh/mesh.h>
 #include <knee_contact/mesh/mesh_readers.h>

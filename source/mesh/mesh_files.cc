@@ -1,5 +1,5 @@
-#include <knee_contact/core/input.h>
-#include <knee_contact/core/interruption.h>
+#include <knee_contact/base/input.h>
+#include <knee_contact/base/interruption.h>
 #include <knee_contact/mesh/gmsh_input.h>
 #include <knee_contact/mesh/mesh.h>
 #include <knee_contact/mesh/mesh_readers.h>

@@ -1,6 +1,6 @@
 // The checks of an ASCII .msh file (format 2.2 or 4.1) before deal.II's
 // GridIn reads it: gmsh_input::check_msh().
-#include <knee_contact/core/input.h>
+#include <knee_contact/base/input.h>
 #include <knee_contact/mesh/gmsh_input.h>
 #include <knee_contact/mesh/mesh.h>
 #include <knee_contact/mesh/readers/line_reader.h>

@@ -1,4 +1,4 @@
-#include <knee_contact/core/input.h>
+#include <knee_contact/base/input.h>
 #include <knee_contact/mesh/gmsh_input.h>
 #include <knee_contact/mesh/readers/line_reader.h>
 

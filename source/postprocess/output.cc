@@ -1,5 +1,6 @@
-#include <knee_contact/core/external_program.h>
-#include <knee_contact/core/input.h>
+#include <knee_contact/base/external_program.h>
+#include <knee_contact/base/input.h>
+#include <knee_contact/base/parallel.h>
 #include <knee_contact/physics/elements.h>
 #include <knee_contact/postprocess/output.h>
 
@@ -139,6 +140,9 @@ namespace knee_contact
     if (output_folder.empty())
       output_folder =
         "output/" + std::filesystem::path(scene_file).stem().string();
+    // Every rank holds the results; rank 0 writes them.
+    if (parallel::rank() != 0)
+      write_files = false;
     for (const auto &[name, point] : label_entries)
       {
         AssertThrow(!name.empty() && point.size() == dim,

@@ -1,5 +1,5 @@
+#include <knee_contact/base/input.h>
 #include <knee_contact/contact/search.h>
-#include <knee_contact/core/input.h>
 #include <knee_contact/physics/elements.h>
 #include <knee_contact/postprocess/refinement.h>
 

@@ -1,5 +1,5 @@
-#include <knee_contact/core/input.h>
-#include <knee_contact/core/progress.h>
+#include <knee_contact/base/input.h>
+#include <knee_contact/base/progress.h>
 #include <knee_contact/solver/active_set.h>
 
 #include <deal.II/lac/dynamic_sparsity_pattern.h>

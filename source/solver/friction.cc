@@ -1,4 +1,4 @@
-#include <knee_contact/core/progress.h>
+#include <knee_contact/base/progress.h>
 #include <knee_contact/solver/active_set.h>
 
 #include <deal.II/base/tensor.h>

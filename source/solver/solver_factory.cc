@@ -1,7 +1,9 @@
-#include <knee_contact/core/memory.h>
+#include <knee_contact/base/memory.h>
+#include <knee_contact/base/parallel.h>
 #include <knee_contact/solver/contact_system.h>
 #include <knee_contact/solver/sparse_cholesky.h>
 
+#include <deal.II/base/mpi.h>
 #include <deal.II/base/timer.h>
 
 #include <algorithm>
@@ -18,6 +20,34 @@ namespace knee_contact
   namespace
   {
     using memory::megabytes;
+
+    /**
+     * memory::available(), the least over the ranks: each rank decides
+     * from the same figure, so all take the same path.
+     */
+    double
+    available_on_every_rank(std::string &limit)
+    {
+      const double available = memory::available(limit);
+      if (parallel::n_ranks() == 1)
+        return available;
+      const auto least =
+        Utilities::MPI::min_max_avg(available, parallel::communicator());
+      limit = Utilities::MPI::broadcast(parallel::communicator(),
+                                        limit,
+                                        least.min_index);
+      return least.min;
+    }
+
+    /** Said of a direct path in a run of several ranks. */
+    std::string
+    on_every_rank()
+    {
+      const unsigned int ranks = parallel::n_ranks();
+      return ranks > 1 ? ", whole on each of the " + std::to_string(ranks) +
+                           " ranks (not distributed)"
+                       : "";
+    }
 
     std::string
     gigaflops(const double flops)
@@ -63,6 +93,7 @@ namespace knee_contact
                       std::string                     &name,
                       std::map<std::string, double>   &figures)
   {
+    figures["ranks"] = parallel::n_ranks();
     if (requested == SolverPath::step41)
       {
         // The first version's path, kept for comparison: UMFPACK's memory
@@ -73,7 +104,10 @@ namespace knee_contact
 
     const auto iterative = [&](const std::string &reason) {
       name = "iterative";
-      log << "   solver: iterative (" << reason << ")" << std::endl;
+      log << "   solver: iterative (" << reason << ")";
+      if (parallel::n_ranks() > 1)
+        log << ", distributed over " << parallel::n_ranks() << " ranks";
+      log << std::endl;
       return std::make_unique<IterativeContactSystem>(
         matrix,
         base,
@@ -87,7 +121,7 @@ namespace knee_contact
         // No direct path is analysed: the memory test is the iterative
         // path's own.
         std::string  limit;
-        const double available = memory::available(limit);
+        const double available = available_on_every_rank(limit);
         const double bytes     = IterativeContactSystem::estimated_bytes(
           matrix.get_sparsity_pattern());
         figures["estimated_iterative_MB"] = bytes / 1048576.;
@@ -186,7 +220,7 @@ namespace knee_contact
                                 fl;
 
     std::string  limit;
-    const double available = memory::available(limit);
+    const double available = available_on_every_rank(limit);
     // Head room for the solution vectors and the results that follow.
     const auto fits = [&](const double bytes) {
       return bytes <= 0.8 * available;
@@ -211,8 +245,10 @@ namespace knee_contact
     const double iterative_bytes =
       IterativeContactSystem::estimated_bytes(sparsity);
     const double krylov_iterations = 30 * iterations + 150;
+    // Several ranks share the iterative path's work (the direct paths run
+    // whole on each).
     const double iterative_seconds =
-      1e-9 * nnz * (75 + 4.7 * krylov_iterations);
+      1e-9 * nnz * (75 + 4.7 * krylov_iterations) / parallel::n_ranks();
     const double cholmod_rate         = 10e9;
     figures["estimated_iterative_MB"] = iterative_bytes / 1048576.;
     figures["estimated_iterative_s"]  = iterative_seconds;
@@ -312,7 +348,8 @@ namespace knee_contact
                                                                  pairs,
                                                                  order);
           name        = "condensed";
-          log << "   solver: condensed (" << reason << ")" << std::endl;
+          log << "   solver: condensed (" << reason << ")" << on_every_rank()
+              << std::endl;
           return system;
         }
       catch (const ContactSystem::ExcNotPositiveDefinite &)
@@ -332,7 +369,8 @@ namespace knee_contact
           sparse = std::make_unique<SparseContactSystem>(matrix, base, pairs);
         }
     name = "sparse";
-    log << "   solver: sparse (" << reason << ")" << std::endl;
+    log << "   solver: sparse (" << reason << ")" << on_every_rank()
+        << std::endl;
     return sparse;
   }
 } // namespace knee_contact

@@ -1,7 +1,7 @@
 #ifndef knee_contact_contact_h
 #define knee_contact_contact_h
 
-#include <knee_contact/solver/contact_row.h>
+#include <knee_contact/contact/contact_row.h>
 
 #include <deal.II/base/parameter_handler.h>
 #include <deal.II/base/point.h>

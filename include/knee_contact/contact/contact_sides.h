@@ -1,9 +1,9 @@
 #ifndef knee_contact_contact_sides_h
 #define knee_contact_contact_sides_h
 
+#include <knee_contact/base/input.h>
 #include <knee_contact/contact/contact.h>
 #include <knee_contact/contact/search.h>
-#include <knee_contact/core/input.h>
 
 #include <deal.II/base/geometry_info.h>
 #include <deal.II/base/point.h>

@@ -1,7 +1,7 @@
 #ifndef knee_contact_rigid_modes_h
 #define knee_contact_rigid_modes_h
 
-#include <knee_contact/solver/contact_row.h>
+#include <knee_contact/contact/contact_row.h>
 
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/vector.h>

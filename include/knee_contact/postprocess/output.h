@@ -1,9 +1,9 @@
 #ifndef knee_contact_output_h
 #define knee_contact_output_h
 
+#include <knee_contact/base/external_program.h>
+#include <knee_contact/base/result_folder.h>
 #include <knee_contact/contact/contact.h>
-#include <knee_contact/core/external_program.h>
-#include <knee_contact/core/result_folder.h>
 #include <knee_contact/physics/materials.h>
 #include <knee_contact/postprocess/error_estimate.h>
 #include <knee_contact/postprocess/results.h>

@@ -1,8 +1,8 @@
 #ifndef knee_contact_active_set_h
 #define knee_contact_active_set_h
 
+#include <knee_contact/contact/contact_row.h>
 #include <knee_contact/physics/rigid_modes.h>
-#include <knee_contact/solver/contact_row.h>
 #include <knee_contact/solver/contact_system.h>
 
 #include <deal.II/base/parameter_handler.h>

@@ -1,8 +1,8 @@
 #ifndef knee_contact_contact_system_h
 #define knee_contact_contact_system_h
 
+#include <knee_contact/contact/contact_row.h>
 #include <knee_contact/physics/rigid_modes.h>
-#include <knee_contact/solver/contact_row.h>
 
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/sparse_matrix.h>

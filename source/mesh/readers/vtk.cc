@@ -1,4 +1,4 @@
-#include <knee_contact/core/memory.h>
+#include <knee_contact/base/memory.h>
 #include <knee_contact/mesh/mesh.h>
 #include <knee_contact/mesh/readers/line_reader.h>
 

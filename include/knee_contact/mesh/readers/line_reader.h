@@ -1,7 +1,7 @@
 #ifndef knee_contact_mesh_readers_line_reader_h
 #define knee_contact_mesh_readers_line_reader_h
 
-#include <knee_contact/core/input.h>
+#include <knee_contact/base/input.h>
 #include <knee_contact/mesh/mesh_readers.h>
 
 #include <fcntl.h>

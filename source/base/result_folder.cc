@@ -1,5 +1,5 @@
-#include <knee_contact/core/interruption.h>
-#include <knee_contact/core/result_folder.h>
+#include <knee_contact/base/interruption.h>
+#include <knee_contact/base/result_folder.h>
 
 #include <fcntl.h>
 #include <sys/file.h>

@@ -17,7 +17,8 @@ namespace knee_contact
      * kills it: the least of MemAvailable, the cgroup's limit (v2 or v1)
      * less its usage, and the address-space limit (ulimit -v) less the
      * process's mapped size (unless not @p address_space: for another
-     * process). @p which names the binding limit.
+     * process), the first two divided by the ranks of the run on this
+     * machine. @p which names the binding limit.
      */
     double
     available(std::string &which, bool address_space = true);

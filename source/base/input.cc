@@ -1,4 +1,4 @@
-#include <knee_contact/core/input.h>
+#include <knee_contact/base/input.h>
 
 #include <deal.II/lac/vector.h>
 

@@ -1,5 +1,5 @@
-#include <knee_contact/core/external_program.h>
-#include <knee_contact/core/interruption.h>
+#include <knee_contact/base/external_program.h>
+#include <knee_contact/base/interruption.h>
 
 #include <fcntl.h>
 #include <poll.h>

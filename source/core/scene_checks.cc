@@ -1,4 +1,4 @@
-#include <knee_contact/mesh/scene_checks.h>
+#include <knee_contact/core/scene_checks.h>
 
 #include <deal.II/base/bounding_box.h>
 #include <deal.II/base/qprojector.h>

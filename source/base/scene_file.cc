@@ -1,4 +1,4 @@
-#include <knee_contact/core/scene_file.h>
+#include <knee_contact/base/scene_file.h>
 
 #include <nlohmann/json.hpp>
 

@@ -1,4 +1,4 @@
-#include <knee_contact/core/interruption.h>
+#include <knee_contact/base/interruption.h>
 
 #include <dirent.h>
 #include <fcntl.h>

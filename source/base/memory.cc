@@ -1,4 +1,5 @@
-#include <knee_contact/core/memory.h>
+#include <knee_contact/base/memory.h>
+#include <knee_contact/base/parallel.h>
 
 #include <dlfcn.h>
 #include <sys/resource.h>
@@ -69,7 +70,13 @@ namespace knee_contact
             which     = name;
           }
       };
-      take(read_field("/proc/meminfo", "MemAvailable:", 1024.), "MemAvailable");
+      // Ranks of one run on this machine share its memory: each may take
+      // its part (they hold about the same).
+      const double ranks = parallel::ranks_on_this_machine();
+      take(read_field("/proc/meminfo", "MemAvailable:", 1024.) / ranks,
+           ranks > 1 ? "MemAvailable / " + std::to_string(int(ranks)) +
+                         " ranks on this machine"
+                     : "MemAvailable");
       for (const auto &[limit, usage] :
            {std::pair<std::string, std::string>{
               "/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"},
@@ -78,7 +85,7 @@ namespace knee_contact
         {
           const double max = read_number(limit), used = read_number(usage);
           if (max >= 0 && max < 1e18 && used >= 0)
-            take(std::max(0., max - used), "the cgroup's memory limit");
+            take(std::max(0., max - used) / ranks, "the cgroup's memory limit");
         }
       if (address_space && address_space_limited())
         take(std::max(0., address_space_limit() - process_virtual()),

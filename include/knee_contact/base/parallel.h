@@ -1,0 +1,77 @@
+#ifndef knee_contact_parallel_h
+#define knee_contact_parallel_h
+
+#include <mpi.h>
+
+#include <string>
+
+namespace knee_contact
+{
+  /**
+   * The processes of a run. Started by mpirun (or mpiexec), every rank
+   * reads the same scene, builds the same mesh and contact rows and runs
+   * the same loop; the iterative path distributes its matrix, AMG
+   * hierarchy and Krylov vectors over the ranks (IterativeContactSystem),
+   * the direct paths run on every rank. Rank 0 alone prints and writes the
+   * result folder; every rank takes the loop's decisions from the same
+   * replicated data, so they agree without a message.
+   *
+   * A lone process (no mpirun) is rank 0 of 1 and initialises MPI only
+   * when Trilinos needs it (ensure_initialised()).
+   */
+  namespace parallel
+  {
+    /** Whether mpirun started this process (Open MPI's, MPICH's or PMIx's
+     * environment says so). */
+    bool
+    launched_by_mpirun();
+
+    /**
+     * Initialise MPI once (finalised at exit). A lone process runs as an
+     * isolated singleton whose session folder is removed on a signal too.
+     */
+    void
+    ensure_initialised();
+
+    /** MPI_COMM_WORLD once initialised, else MPI_COMM_SELF. */
+    MPI_Comm
+    communicator();
+
+    /** Number of ranks (1 for a lone process). */
+    unsigned int
+    n_ranks();
+
+    /** This process's rank (0 for a lone process). */
+    unsigned int
+    rank();
+
+    /**
+     * Ranks sharing this machine's memory (MPI_Comm_split_type): the
+     * memory a path may take is what the machine has divided by them.
+     */
+    unsigned int
+    ranks_on_this_machine();
+
+    /**
+     * Ranks other than 0 print nothing: std::cout and std::cerr go to a
+     * sink (a rank's own failure is printed by finish_failed()).
+     */
+    void
+    quiet_other_ranks();
+
+    /**
+     * The end of a run on this rank with exit code @p code and, if it
+     * failed, its one-line @p message. One rank: the message is printed.
+     * Several: rank 0 prints its own; then every rank waits (at most
+     * @p seconds) until all have ended. If they all did, each returns its
+     * code (a failure of the replicated work, bad input say, happened on
+     * every rank and is printed once). A rank that failed alone, while the
+     * others wait in a collective operation, prints its message and ends
+     * the whole run (MPI_Abort with its code): no rank hangs.
+     */
+    int
+    finish(const int code, const std::string &message, const double seconds);
+  } // namespace parallel
+} // namespace knee_contact
+
+#endif

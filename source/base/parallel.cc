@@ -1,0 +1,226 @@
+#include <knee_contact/base/interruption.h>
+#include <knee_contact/base/parallel.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <streambuf>
+#include <thread>
+
+namespace knee_contact
+{
+  namespace parallel
+  {
+    namespace
+    {
+      bool
+      initialised()
+      {
+        int flag = 0;
+        MPI_Initialized(&flag);
+        int finalised = 0;
+        MPI_Finalized(&finalised);
+        return flag != 0 && finalised == 0;
+      }
+
+      /** Where a quiet rank's output goes. */
+      class Sink : public std::streambuf
+      {
+      protected:
+        int
+        overflow(int c) override
+        {
+          return traits_type::not_eof(c);
+        }
+      };
+
+      Sink            sink;
+      std::streambuf *cerr_buffer = nullptr;
+      /** Counted once at the start (a collective operation: memory checks
+       * are made by one rank alone, when it writes the results). */
+      unsigned int ranks_sharing_memory = 1;
+    } // namespace
+
+
+
+    bool
+    launched_by_mpirun()
+    {
+      for (const char *variable :
+           {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_RANK", "PMI_RANK"})
+        if (std::getenv(variable) != nullptr)
+          return true;
+      return false;
+    }
+
+
+
+    /**
+     * Trilinos' Epetra objects need MPI; a lone process initialises it
+     * only when the iterative path is taken (and finalises it at exit).
+     *
+     * A process not started by mpirun is an Open MPI "singleton". By
+     * default it forks a daemon (orted) and keeps a session folder under
+     * TMPDIR (ompi.<host>.<uid>/jf.<n>) that only MPI_Finalize removes: a
+     * run stopped by a signal, whose handler must _exit, left one folder
+     * per run in /tmp (measured). So a singleton runs isolated (no daemon)
+     * with its session folder inside a private folder of its own, which
+     * the interruption handler removes on a signal and the exit handler
+     * after MPI_Finalize. Only a SIGKILL can leave it. Under mpirun the
+     * launcher owns the session.
+     */
+    void
+    ensure_initialised()
+    {
+      int flag = 0;
+      MPI_Initialized(&flag);
+      if (flag)
+        return;
+      static std::string session_folder;
+      if (!launched_by_mpirun())
+        {
+          // Open MPI's shared-memory and network transports would map
+          // memory and plugins (and fail under an address-space limit,
+          // measured), so only its "self" transport is loaded unless the
+          // user chose otherwise.
+          setenv("OMPI_MCA_btl", "self", 0);
+          setenv("OMPI_MCA_ess_singleton_isolated", "1", 0);
+          if (std::getenv("OMPI_MCA_orte_tmpdir_base") == nullptr)
+            {
+              const char *tmpdir = std::getenv("TMPDIR");
+              std::string pattern =
+                (tmpdir != nullptr && tmpdir[0] == '/' ? tmpdir : "/tmp");
+              pattern += "/knee_contact-mpi-XXXXXX";
+              if (mkdtemp(pattern.data()) != nullptr)
+                {
+                  session_folder = pattern;
+                  interruption::register_folder(session_folder);
+                  setenv("OMPI_MCA_orte_tmpdir_base",
+                         session_folder.c_str(),
+                         1);
+                }
+            }
+        }
+      int provided = 0;
+      MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided);
+      MPI_Comm shared;
+      MPI_Comm_split_type(
+        MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &shared);
+      int size = 1;
+      MPI_Comm_size(shared, &size);
+      MPI_Comm_free(&shared);
+      ranks_sharing_memory = size;
+      std::atexit([]() {
+        int finalised = 0;
+        MPI_Finalized(&finalised);
+        if (!finalised)
+          MPI_Finalize();
+        if (!session_folder.empty())
+          {
+            std::error_code ignored;
+            std::filesystem::remove_all(session_folder, ignored);
+            interruption::unregister_folder(session_folder);
+          }
+      });
+    }
+
+
+
+    MPI_Comm
+    communicator()
+    {
+      return initialised() ? MPI_COMM_WORLD : MPI_COMM_SELF;
+    }
+
+
+
+    unsigned int
+    n_ranks()
+    {
+      if (!initialised())
+        return 1;
+      int size = 1;
+      MPI_Comm_size(MPI_COMM_WORLD, &size);
+      return size;
+    }
+
+
+
+    unsigned int
+    rank()
+    {
+      if (!initialised())
+        return 0;
+      int rank = 0;
+      MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+      return rank;
+    }
+
+
+
+    unsigned int
+    ranks_on_this_machine()
+    {
+      return n_ranks() == 1 ? 1 : ranks_sharing_memory;
+    }
+
+
+
+    void
+    quiet_other_ranks()
+    {
+      if (rank() == 0)
+        return;
+      std::cout.rdbuf(&sink);
+      cerr_buffer = std::cerr.rdbuf(&sink);
+    }
+
+
+
+    int
+    finish(const int code, const std::string &message, const double seconds)
+    {
+      if (n_ranks() == 1)
+        {
+          if (!message.empty())
+            std::cerr << message << std::endl;
+          return code;
+        }
+      // Wait for the others without blocking: a rank stuck in a collective
+      // operation never arrives. A rank that succeeded waits as long as
+      // the others take (they do the same work).
+      MPI_Request request;
+      MPI_Ibarrier(MPI_COMM_WORLD, &request);
+      const auto end = std::chrono::steady_clock::now() +
+                       std::chrono::duration<double>(seconds);
+      int arrived = 0;
+      while (true)
+        {
+          MPI_Test(&request, &arrived, MPI_STATUS_IGNORE);
+          if (arrived || (code != 0 && std::chrono::steady_clock::now() > end))
+            break;
+          std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        }
+      const auto say = [&](const std::string &suffix) {
+        if (cerr_buffer != nullptr)
+          std::cerr.rdbuf(cerr_buffer);
+        if (!message.empty())
+          std::cerr << message << suffix << std::endl;
+      };
+      if (!arrived)
+        {
+          // Only this rank left the run: say why and end the others.
+          say(" (rank " + std::to_string(rank()) + ")");
+          MPI_Abort(MPI_COMM_WORLD, code);
+        }
+      // Every rank has ended: the lowest that failed speaks for all.
+      const int mine  = code != 0 ? int(rank()) : int(n_ranks());
+      int       first = mine;
+      MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+      if (first == int(rank()))
+        say("");
+      return code;
+    }
+  } // namespace parallel
+} // namespace knee_contact

@@ -1,0 +1,341 @@
+#!/usr/bin/python3
+"""Runs under mpirun against the one-process run of the same scene.
+
+1. Each scene of SCENES runs as one process (no mpirun) and under
+   `mpirun -np N`. Asserted, relative to the largest value of its kind in
+   the one-process run: every number of summary.json (energy, reactions,
+   forces, pressures, stresses, areas, stick and slip counts, per load
+   case too) to 1e-8; the displacement of every vertex (solution.vtu) to
+   1e-8 of max |u|; every contact CSV column to 1e-8 of its largest value,
+   and its flags (active, stick or slip, the discretisation) equal. The error
+   bars (influence solves stopped at 1e-3) to 1e-2 of the largest bar.
+   The distributed iterative path (Contact/Solver = iterative: CG and AMG
+   over the ranks, to 1e-12 of the load) and the direct paths (whole on
+   each rank) both; measured: at most 1.1e-11 (the 3D knee at 2.3e5 dofs,
+   doc/parallel.md).
+2. More ranks than cells on a body: a block of one cell on a base, three
+   ranks, the iterative path (a rank may own no vertex of a body).
+3. Bad input under mpirun: exit code 1 and the one-line error printed once
+   (not once per rank).
+Usage: parallel.py KNEE_CONTACT
+"""
+import csv
+import glob
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+import vtk
+from vtk.util.numpy_support import vtk_to_numpy
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import friction  # noqa: E402
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SCENES_FOLDER = os.path.join(HERE, "..", "scenes")
+# (scene of tests/scenes, Contact/Solver or None for the scene's own, ranks)
+SCENES = [("contact_patch_3d_tet_iterative.prm", None, 2),
+          ("contact_patch_3d_hex.prm", "iterative", 2),
+          ("hertz_small.prm", "iterative", 2),
+          ("knee_small.prm", None, 2),
+          ("friction_sliding_block.prm", None, 2),
+          ("load_cases_patch.prm", "iterative", 2)]
+TOLERANCE = 1e-8
+BAR_TOLERANCE = 1e-2
+# Round-off measures and what depends on the path taken, not the answer.
+SKIPPED = ("wall_time", "solver", "active_set_iterations",
+           "equilibrium_residual", "relative_max_penetration",
+           "complementarity_residual", "max_penetration",
+           # under a uniform pressure every pair ties up to round-off
+           "peak_location")
+# CSV columns of motions: their scale is max |u| (a closed gap's jump is
+# round-off beside it).
+MOTIONS = ("gap", "jump", "slip", "accumulated_slip")
+FLAGS = ("active",)
+
+
+def number(text):
+    """Whether a CSV field is a number (else a flag such as stick/slip)."""
+    try:
+        float(text)
+        return True
+    except ValueError:
+        return False
+
+
+def mpi_environment():
+    """Open MPI as root (CI) and on more ranks than cores."""
+    env = dict(os.environ)
+    env.update({"OMPI_ALLOW_RUN_AS_ROOT": "1",
+                "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
+                "OMPI_MCA_rmaps_base_oversubscribe": "1"})
+    return env
+
+
+def run(binary, scene, ranks):
+    """knee_contact on @p scene, by one process (0 ranks: no mpirun) or
+    under mpirun -np @p ranks."""
+    command = [binary, scene]
+    if ranks:
+        command = ["mpirun", "--oversubscribe", "-np", str(ranks)] + command
+    return subprocess.run(command, stdout=subprocess.PIPE,
+                          stderr=subprocess.PIPE, text=True,
+                          env=mpi_environment(), timeout=600)
+
+
+def numbers(value, path=""):
+    """(path, number) of summary.json but SKIPPED."""
+    if isinstance(value, dict):
+        for k, v in value.items():
+            if k not in SKIPPED:
+                yield from numbers(v, path + "/" + k)
+    elif isinstance(value, list):
+        for i, v in enumerate(value):
+            yield from numbers(v, path + "[%d]" % i)
+    elif isinstance(value, (int, float)) and not isinstance(value, bool):
+        yield path, float(value)
+
+
+def kind(key):
+    """The scale of a number: the error bars one kind, the stresses one,
+    each quantity of the contact interfaces one (force, max_pressure, ...),
+    else its entry (reactions, energy, ...)."""
+    parts = key.split("/")
+    if "error" in key:
+        return "error"
+    if "stress" in parts[1] or "mises" in parts[1]:
+        return "stress"
+    if parts[1] in ("contact_interfaces", "load_cases"):
+        return re.sub(r"\[\d+\]", "", parts[-1])
+    return re.sub(r"\[\d+\]", "", parts[1])
+
+
+def worst_difference(name, reference, other, failures):
+    """Every number of two summaries, relative to the largest of its kind."""
+    a, b = dict(numbers(reference)), dict(numbers(other))
+    if a.keys() != b.keys():
+        failures.append("%s: summary entries differ: %s" % (name,
+                                                            a.keys() ^ b.keys()))
+        return 0.0
+    worst = 0.0
+    for key in a:
+        scale = max(abs(v) for k, v in a.items() if kind(k) == kind(key))
+        error = abs(a[key] - b[key]) / (scale or 1.0)
+        tolerance = BAR_TOLERANCE if kind(key) == "error" else TOLERANCE
+        if kind(key) != "error":
+            worst = max(worst, error)
+        if error > tolerance:
+            failures.append("%s: %s = %r, one process %r" % (name, key, b[key],
+                                                             a[key]))
+    return worst
+
+
+def summaries(folder):
+    """Every summary.json below @p folder (one per load case)."""
+    result = {}
+    for path in sorted(glob.glob(os.path.join(folder, "**", "summary.json"),
+                                 recursive=True)):
+        with open(path) as f:
+            result[os.path.relpath(path, folder)] = json.load(f)
+    return result
+
+
+def displacements(folder):
+    """The point displacements of every solution.vtu below @p folder."""
+    fields = {}
+    for path in sorted(glob.glob(os.path.join(folder, "**", "solution.vtu"),
+                                 recursive=True)):
+        reader = vtk.vtkXMLUnstructuredGridReader()
+        reader.SetFileName(path)
+        reader.Update()
+        data = reader.GetOutput().GetPointData().GetArray("displacement")
+        fields[os.path.relpath(path, folder)] = vtk_to_numpy(data)
+    return fields
+
+
+def tables(folder):
+    """The rows of every contact CSV below @p folder."""
+    result = {}
+    for path in sorted(glob.glob(os.path.join(folder, "**", "contact_*.csv"),
+                                 recursive=True)):
+        with open(path) as f:
+            result[os.path.relpath(path, folder)] = list(csv.DictReader(f))
+    return result
+
+
+def compare_fields(name, one, many, failures):
+    """Displacements and contact tables of two result folders; returns the
+    largest relative difference."""
+    worst = 0.0
+    u1, u2 = displacements(one), displacements(many)
+    if not u1 or u1.keys() != u2.keys():
+        failures.append("%s: solution.vtu files %s against %s" %
+                        (name, sorted(u1), sorted(u2)))
+    u_scale = max([abs(u).max() for u in u1.values()] + [0.0])
+    for path in u1:
+        if path in u2:
+            scale = abs(u1[path]).max() or 1.0
+            error = abs(u1[path] - u2[path]).max() / scale
+            worst = max(worst, error)
+            if error > TOLERANCE:
+                failures.append("%s: %s displacement differs by %.1e of max "
+                                "|u|" % (name, path, error))
+    t1, t2 = tables(one), tables(many)
+    if t1.keys() != t2.keys():
+        failures.append("%s: contact CSVs %s against %s" %
+                        (name, sorted(t1), sorted(t2)))
+    for path in t1:
+        rows1, rows2 = t1[path], t2.get(path, [])
+        if len(rows1) != len(rows2):
+            failures.append("%s: %s has %d rows, one process %d" %
+                            (name, path, len(rows2), len(rows1)))
+            continue
+        for column in (rows1[0].keys() if rows1 else []):
+            if column in FLAGS or not all(number(r[column]) for r in rows1):
+                changed = sum(r1[column] != r2[column]
+                              for r1, r2 in zip(rows1, rows2))
+                if changed:
+                    failures.append("%s: %s: %d rows differ in %s" %
+                                    (name, path, changed, column))
+                continue
+            values1 = [float(r[column]) for r in rows1]
+            values2 = [float(r[column]) for r in rows2]
+            scale = max(abs(v) for v in values1)
+            if column in MOTIONS:
+                scale = max(scale, u_scale)
+            scale = scale or 1.0
+            error = max(abs(x - y) for x, y in zip(values1, values2)) / scale
+            worst = max(worst, error)
+            if error > TOLERANCE:
+                failures.append("%s: %s column %s differs by %.1e of its "
+                                "largest" % (name, path, column, error))
+    return worst
+
+
+def scene_text(scene, solver, folder):
+    """The scene with absolute mesh paths, the solver path and its results
+    written into @p folder."""
+    text = open(os.path.join(SCENES_FOLDER, scene)).read()
+    text = re.sub(r"(set File\s*=\s*)(\S+)",
+                  lambda m: m.group(1) + os.path.normpath(
+                      os.path.join(SCENES_FOLDER, m.group(2))), text)
+    if solver:
+        text = re.sub(r"\n\s*set Solver\s*=.*", "", text)
+        text = text.replace("subsection Contact",
+                            "subsection Contact\n  set Solver = %s" % solver,
+                            1)
+    if "subsection Output" not in text:
+        text += "subsection Output\nend\n"
+    return friction.with_output(text, folder)
+
+
+def compare_runs(binary, folder, name, text, ranks, failures):
+    """Run @p text by one process and by @p ranks; compare."""
+    results = {}
+    for count in (0, ranks):
+        out = os.path.join(folder, "%s_%d" % (name, count))
+        scene = os.path.join(folder, "%s_%d.prm" % (name, count))
+        with open(scene, "w") as f:
+            f.write(text.replace("@FOLDER@", out))
+        result = run(binary, scene, count)
+        if result.returncode != 0:
+            print(result.stdout[-3000:], result.stderr[-3000:])
+            failures.append("%s on %d ranks: exit code %d" %
+                            (name, max(count, 1), result.returncode))
+            return
+        results[count] = out
+    one, many = summaries(results[0]), summaries(results[ranks])
+    worst = 0.0
+    for path, summary in many.items():
+        if summary["solver"].get("ranks") != ranks:
+            failures.append("%s/%s: solver ranks %r, not %d" %
+                            (name, path, summary["solver"].get("ranks"),
+                             ranks))
+    if not one or one.keys() != many.keys():
+        failures.append("%s: summaries %s against %s" % (name, sorted(one),
+                                                         sorted(many)))
+    for path in one:
+        if path in many:
+            worst = max(worst, worst_difference(name + "/" + path, one[path],
+                                                many[path], failures))
+    worst = max(worst, compare_fields(name, results[0], results[ranks],
+                                      failures))
+    paths = sorted({summary["solver"]["name"] for summary in many.values()})
+    print("%s: %d ranks (%s) against one process: largest relative "
+          "difference %.1e (tolerance %.0e)" % (name, ranks, ", ".join(paths),
+                                                worst, TOLERANCE))
+
+
+BLOCK = """subsection Mesh
+  #                x0 y0 x1 y1 nx ny mat group left right bottom top
+  set Source     = rectangles
+  set Rectangles = 0, 0, 1, 0.5, 4, 2, 1, 0, 1, 1, 2, 3; \\
+                   0.25, 0.5, 0.75, 0.75, 1, 1, 2, 1, 4, 4, 5, 6
+end
+%ssubsection Boundary conditions
+  set Number of conditions = 3
+  subsection Condition 0
+    set Boundary ids = 2
+    set Type         = displacement
+  end
+  subsection Condition 1
+    set Boundary ids = 4
+    set Type         = sliding
+  end
+  subsection Condition 2
+    set Boundary ids = 6
+    set Type         = traction
+    set Value        = 0; -1e6
+  end
+end
+subsection Contact
+  set Solver = iterative
+  set Number of interfaces = 1
+  subsection Interface 0
+    set Name               = block
+    set Slave boundary id  = 5
+    set Master boundary id = 3
+  end
+end
+subsection Output
+  set Folder   = @FOLDER@
+  set Pictures = false
+end
+""" % friction.MATERIALS
+
+
+def main():
+    binary = os.path.abspath(sys.argv[1])
+    failures = []
+    with tempfile.TemporaryDirectory() as folder:
+        for scene, solver, ranks in SCENES:
+            name = scene[:-4] + ("_" + solver if solver else "")
+            compare_runs(binary, folder, name,
+                         scene_text(scene, solver, "@FOLDER@"), ranks,
+                         failures)
+        compare_runs(binary, folder, "one_cell_block", BLOCK, 3, failures)
+
+        # Bad input: refused by every rank, said once.
+        bad = os.path.join(folder, "bad.prm")
+        with open(bad, "w") as f:
+            f.write(BLOCK.replace("set Young's modulus = 3e9",
+                                  "set Young's modulus = -3e9")
+                    .replace("@FOLDER@", os.path.join(folder, "bad")))
+        result = run(binary, bad, 2)
+        said = [line for line in result.stderr.splitlines()
+                if line.startswith("knee_contact: error:")]
+        print("bad input on 2 ranks: exit code %d, %d error line(s): %s" %
+              (result.returncode, len(said), said))
+        if result.returncode != 1 or len(said) != 1 or "Young" not in said[0]:
+            failures.append("bad input on 2 ranks: exit code %d, error "
+                            "lines %s" % (result.returncode, said))
+    for failure in failures:
+        print("FAIL " + failure)
+    sys.exit(1 if failures else 0)
+
+
+if __name__ == "__main__":
+    main()
