@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <csignal>
 #include <cstring>
+#include <ctime>
 
 namespace knee_contact
 {
@@ -117,6 +118,11 @@ namespace knee_contact
             unlink(file);
       }
 
+      /** Set on the ranks other than 0 of a parallel run: one says it. */
+      volatile sig_atomic_t quiet = 0;
+      /** Set once the result set has replaced the output folder. */
+      volatile sig_atomic_t written = 0;
+
       void
       handle(const int signal)
       {
@@ -131,10 +137,25 @@ namespace knee_contact
               }
           }
         remove_folders_and_files();
-        const char message[] = "knee_contact: interrupted by a signal; the "
-                               "output folder is unchanged\n";
-        [[maybe_unused]] const auto written =
-          write(STDERR_FILENO, message, sizeof(message) - 1);
+        const char unchanged[] = "knee_contact: interrupted by a signal; "
+                                 "the output folder is unchanged\n";
+        const char complete[]  = "knee_contact: interrupted by a signal "
+                                 "after its results were written\n";
+        if (!quiet) [[maybe_unused]]
+          const auto said =
+            written ? write(STDERR_FILENO, complete, sizeof(complete) - 1)
+                    : write(STDERR_FILENO, unchanged, sizeof(unchanged) - 1);
+        // A rank other than 0 leaves after rank 0 has removed the staging
+        // folder (a load path's holds a folder per case): mpirun ends the
+        // job with SIGKILL once one rank has left, and rank 0 killed in
+        // its cleanup left its staging folder and lock (measured, 1001
+        // cases). It waits at most 5 s (nanosleep is async-signal-safe).
+        if (quiet)
+          {
+            struct timespec wait = {5, 0};
+            while (nanosleep(&wait, &wait) != 0 && errno == EINTR)
+              ;
+          }
         _exit(128 + signal);
       }
     } // namespace
@@ -150,6 +171,22 @@ namespace knee_contact
       sigfillset(&action.sa_mask);
       for (const int signal : {SIGINT, SIGTERM, SIGHUP})
         sigaction(signal, &action, nullptr);
+    }
+
+
+
+    void
+    say_nothing()
+    {
+      quiet = 1;
+    }
+
+
+
+    void
+    results_written()
+    {
+      written = 1;
     }
 
 

@@ -174,6 +174,7 @@ namespace knee_contact
         return;
       std::cout.rdbuf(&sink);
       cerr_buffer = std::cerr.rdbuf(&sink);
+      interruption::say_nothing();
     }
 
 

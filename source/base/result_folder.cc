@@ -180,6 +180,7 @@ namespace knee_contact
         if (std::rename(staging_folder.c_str(), folder.c_str()) != 0)
           throw error("cannot rename '" + staging_folder + "' to '" + folder +
                       "': " + std::strerror(errno));
+        interruption::results_written();
         committed = true;
         return;
       }
@@ -198,10 +199,12 @@ namespace knee_contact
             std::rename(staging_folder.c_str(), folder.c_str()) != 0)
           throw error("cannot replace '" + folder +
                       "': " + std::strerror(errno));
+        interruption::results_written();
         fs::remove_all(previous, code);
         committed = true;
         return;
       }
+    interruption::results_written();
     fs::remove_all(staging_folder, code);
     committed = true;
   }

@@ -37,6 +37,16 @@ namespace knee_contact
     void
     unregister_folder(const std::string &folder);
 
+    /** The result set has replaced the output folder: a later signal
+     * says so instead of "unchanged". */
+    void
+    results_written();
+
+    /** The handler prints nothing (the ranks other than 0 of a parallel
+     * run, which mpirun signals too). */
+    void
+    say_nothing();
+
     /**
      * Remove every registered folder and file now, as the handler would:
      * for a process that leaves by std::_Exit (out of memory, an
