@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <sstream>
 
 namespace knee_contact
@@ -37,6 +38,30 @@ namespace knee_contact
     }
 
     /**
+     * A spring of ContactSystem::Spring on the dofs: energy
+     * 1/2 k (w . x - g_w)^2, w = sum_r c_r a'_r over the rows' reduced rows
+     * (the dofs Gamma_u and Gamma_o leave free), g_w the same sum of their
+     * reduced gaps: the terms the condensed path adds to its Schur
+     * complement, here added to the operator (k w w^T), to the right hand
+     * side and to the residual of the multipliers.
+     */
+    struct SpringTerm
+    {
+      std::vector<std::pair<types::global_dof_index, double>> w;
+      double                                                  g_w       = 0;
+      double                                                  stiffness = 0;
+
+      double
+      dot(const Vector<double> &x) const
+      {
+        double value = 0;
+        for (const auto &[i, a] : w)
+          value += a * x(i);
+        return value;
+      }
+    };
+
+    /**
      * The condensed operator of one active set, T^T C T on the free dofs
      * and C's diagonal on the constrained ones (whose right hand side is
      * zero), applied with the stiffness matrix itself: no copy per set.
@@ -45,9 +70,11 @@ namespace knee_contact
     {
     public:
       CondensedOperator(const SparseMatrix<double>      &matrix,
-                        const AffineConstraints<double> &constraints)
+                        const AffineConstraints<double> &constraints,
+                        const std::vector<SpringTerm>   &springs)
         : matrix(matrix)
         , constraints(constraints)
+        , springs(springs)
         , spread(matrix.m())
       {}
 
@@ -57,6 +84,12 @@ namespace knee_contact
         spread = src;
         sparse_cholesky::distribute_homogeneous(constraints, spread);
         matrix.vmult(dst, spread);
+        for (const auto &spring : springs)
+          {
+            const double force = spring.stiffness * spring.dot(spread);
+            for (const auto &[i, a] : spring.w)
+              dst(i) += force * a;
+          }
         sparse_cholesky::condense_homogeneous(constraints, dst);
         for (const auto &line : constraints.get_lines())
           dst(line.index) = matrix.diag_element(line.index) * src(line.index);
@@ -68,6 +101,7 @@ namespace knee_contact
     private:
       const SparseMatrix<double>      &matrix;
       const AffineConstraints<double> &constraints;
+      const std::vector<SpringTerm>   &springs;
       mutable Vector<double>           spread;
     };
 
@@ -87,9 +121,20 @@ namespace knee_contact
     public:
       DistributedCondensedOperator(const TrilinosWrappers::SparseMatrix &matrix,
                                    const AffineConstraints<double> &constraints,
-                                   const IndexSet                  &owned)
+                                   const IndexSet                  &owned,
+                                   const std::vector<SpringTerm>   &springs)
         : matrix(matrix)
+        , springs(springs)
       {
+        // Each spring's owned entries (dof, coefficient).
+        for (const auto &spring : springs)
+          {
+            std::vector<std::pair<types::global_dof_index, double>> local;
+            for (const auto &[i, a] : spring.w)
+              if (owned.is_element(i))
+                local.emplace_back(i, a);
+            owned_w.push_back(std::move(local));
+          }
         const MPI_Comm comm = matrix.get_mpi_communicator();
         IndexSet       masters(owned.size());
         for (const auto &line : constraints.get_lines())
@@ -124,6 +169,21 @@ namespace knee_contact
             spread(line.index) = value;
           }
         matrix.vmult(product, spread);
+        if (!springs.empty())
+          {
+            // w . x over the ranks' owned entries, summed by one reduction
+            // for all springs.
+            std::vector<double> stretch(springs.size(), 0.);
+            for (unsigned int k = 0; k < springs.size(); ++k)
+              for (const auto &[i, a] : owned_w[k])
+                stretch[k] += a * spread(i);
+            Utilities::MPI::sum(stretch,
+                                matrix.get_mpi_communicator(),
+                                stretch);
+            for (unsigned int k = 0; k < springs.size(); ++k)
+              for (const auto &[i, a] : owned_w[k])
+                product(i) += springs[k].stiffness * stretch[k] * a;
+          }
         to_masters = 0;
         for (const auto &line : lines)
           {
@@ -143,6 +203,9 @@ namespace knee_contact
 
     private:
       const TrilinosWrappers::SparseMatrix &matrix;
+      const std::vector<SpringTerm>        &springs;
+      std::vector<std::vector<std::pair<types::global_dof_index, double>>>
+        owned_w;
       /** The constrained dofs of this rank with their masters. */
       std::vector<AffineConstraints<double>::ConstraintLine> lines;
       std::vector<double>                                    diagonal;
@@ -225,6 +288,8 @@ namespace knee_contact
     std::vector<double>              null_space;
     unsigned int                     n_modes = 0;
 
+    /** The springs of the following solves (set_springs()). */
+    std::vector<iterative::SpringTerm> springs;
     /** The rows of this rank (all of them on one). */
     IndexSet                       owned;
     AffineConstraints<double>      constraints;
@@ -460,7 +525,7 @@ namespace knee_contact
     };
     if (parallel::n_ranks() == 1)
       {
-        iterative::CondensedOperator operation(matrix, constraints);
+        iterative::CondensedOperator operation(matrix, constraints, springs);
         Vector<double>               start_residual(b.size());
         operation.vmult(start_residual, y);
         start_residual.sadd(-1., 1., b);
@@ -475,7 +540,8 @@ namespace knee_contact
       copy_rows(matrix, distributed_matrix);
     const iterative::DistributedCondensedOperator operation(distributed_matrix,
                                                             constraints,
-                                                            owned);
+                                                            owned,
+                                                            springs);
     const MPI_Comm                comm = parallel::communicator();
     TrilinosWrappers::MPI::Vector y_owned(owned, comm), b_owned(owned, comm),
       start_residual(owned, comm);
@@ -553,8 +619,25 @@ namespace knee_contact
     Timer clock;
     ActiveSetSolver::make_constraints(d.base, d.pairs, active, d.constraints);
     // The condensed right hand side T^T (d - C g), g the inhomogeneities.
-    const Vector<double> b =
+    Vector<double> b =
       sparse_cholesky::condense(d.matrix, *d.rhs, d.constraints);
+    if (!d.springs.empty())
+      {
+        // T^T sum k w (g_w - w . g), g the constraints' inhomogeneities.
+        Vector<double> g(d.matrix.m()), pull(d.matrix.m());
+        d.constraints.distribute(g);
+        for (const auto &spring : d.springs)
+          {
+            const double force =
+              spring.stiffness * (spring.g_w - spring.dot(g));
+            for (const auto &[i, a] : spring.w)
+              pull(i) += force * a;
+          }
+        sparse_cholesky::condense_homogeneous(d.constraints, pull);
+        for (const auto &line : d.constraints.get_lines())
+          pull(line.index) = 0;
+        b += pull;
+      }
     d.condensation += clock.wall_time();
 
     // A hierarchy is kept while the CG iterations it costs beyond its rate
@@ -624,8 +707,50 @@ namespace knee_contact
     // side exist: the figure its estimate is checked against.
     if (d.totals.n_solves == 1)
       d.measured_MB = iterative::resident_MB() - d.resident_at_start;
-    ActiveSetSolver::excess_and_multipliers(
-      d.matrix, *d.rhs, d.x, d.base, d.pairs, active, excess, lambda);
+    if (d.springs.empty())
+      ActiveSetSolver::excess_and_multipliers(
+        d.matrix, *d.rhs, d.x, d.base, d.pairs, active, excess, lambda);
+    else
+      {
+        // The residual less the springs' forces k (w x - g_w) w.
+        Vector<double> residual(d.matrix.m());
+        d.matrix.residual(residual, d.x, *d.rhs);
+        for (const auto &spring : d.springs)
+          {
+            const double force =
+              spring.stiffness * (spring.dot(d.x) - spring.g_w);
+            for (const auto &[i, a] : spring.w)
+              residual(i) -= force * a;
+          }
+        lambda =
+          ActiveSetSolver::multipliers(residual, d.base, d.pairs, active);
+        excess.resize(d.pairs.size());
+        for (unsigned int p = 0; p < d.pairs.size(); ++p)
+          excess[p] = d.pairs[p].jump(d.x) - d.pairs[p].gap;
+      }
+  }
+
+
+
+  void
+  IterativeContactSystem::set_springs(const std::vector<Spring> &springs)
+  {
+    Implementation &d = *implementation;
+    d.springs.clear();
+    for (const auto &spring : springs)
+      {
+        iterative::SpringTerm term;
+        term.stiffness = spring.stiffness;
+        std::map<types::global_dof_index, double> w;
+        for (const auto &[r, c] : spring.rows)
+          {
+            for (const auto &[i, a] : d.pairs[r].reduced_row)
+              w[i] += c * a;
+            term.g_w += c * d.pairs[r].reduced_gap;
+          }
+        term.w.assign(w.begin(), w.end());
+        d.springs.push_back(std::move(term));
+      }
   }
 
 

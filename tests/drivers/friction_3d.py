@@ -26,9 +26,10 @@
    interface force balances the load to 1e-8; above, one line refuses it
    naming the ratio 1.2 x 0.3 = 0.36.
 Each held case runs on the automatic path (condensed: the semismooth Newton
-step, 9-10 iterations) and on the sparse one (which takes no springs: the
+step, 9-10 iterations), on the sparse one (which takes no springs: the
 Anderson-accelerated fixed point on the slip forces, 19-62 iterations; the
-scenes allow 100); their energy and max |u| agree to 1e-8.
+scenes allow 100) and on the iterative one (the Newton springs applied in
+CG with AMG); their energy and max |u| agree to 1e-8.
 Usage: friction_3d.py KNEE_CONTACT
 """
 import json
@@ -199,10 +200,11 @@ def main():
                     name = "statics_%g_%g_%s" % (angle, ratio, pairing)
                     if ratio < mu:
                         # The automatic path (condensed: the semismooth
-                        # Newton step) and the sparse one (no springs: the
-                        # accelerated fixed point) must agree.
+                        # Newton step), the sparse one (no springs: the
+                        # accelerated fixed point) and the iterative one
+                        # (the Newton springs applied in CG) must agree.
                         found = {}
-                        for solver in ("automatic", "sparse"):
+                        for solver in ("automatic", "sparse", "iterative"):
                             summary = run(binary, stack(
                                 load, folder, name + solver, pairing=pairing,
                                 mu=mu, angle=angle, solver=solver), folder,
@@ -219,12 +221,13 @@ def main():
                                      iterations(summary)))
                             failures += error > 1e-8
                         difference = max(
-                            abs(found["automatic"][key] -
+                            abs(found[other][key] -
                                 found["sparse"][key]) / abs(
                                 found["sparse"][key])
-                            for key in ("energy", "max_displacement"))
-                        print("  the two paths' energy and max |u| differ by "
-                              "%.1e (tolerance 1e-8)" % difference)
+                            for key in ("energy", "max_displacement")
+                            for other in ("automatic", "iterative"))
+                        print("  the three paths' energy and max |u| differ "
+                              "by %.1e (tolerance 1e-8)" % difference)
                         failures += difference > 1e-8
                     # Below the ratio (the level stack at mu = 0.1, the
                     # tilted one at 1.03 mu): refused, naming it.
