@@ -95,19 +95,6 @@ def run(binary, scene, ranks):
                           env=mpi_environment(), timeout=600)
 
 
-def numbers(value, path=""):
-    """(path, number) of summary.json but SKIPPED."""
-    if isinstance(value, dict):
-        for k, v in value.items():
-            if k not in SKIPPED:
-                yield from numbers(v, path + "/" + k)
-    elif isinstance(value, list):
-        for i, v in enumerate(value):
-            yield from numbers(v, path + "[%d]" % i)
-    elif isinstance(value, (int, float)) and not isinstance(value, bool):
-        yield path, float(value)
-
-
 def kind(key):
     """The scale of a number: the error bars one kind, the stresses one,
     each quantity of the contact interfaces one (force, max_pressure, ...),
@@ -124,7 +111,8 @@ def kind(key):
 
 def worst_difference(name, reference, other, failures):
     """Every number of two summaries, relative to the largest of its kind."""
-    a, b = dict(numbers(reference)), dict(numbers(other))
+    a = dict(friction.numbers(reference, skipped=SKIPPED))
+    b = dict(friction.numbers(other, skipped=SKIPPED))
     if a.keys() != b.keys():
         failures.append("%s: summary entries differ: %s" % (name,
                                                             a.keys() ^ b.keys()))
@@ -142,44 +130,39 @@ def worst_difference(name, reference, other, failures):
     return worst
 
 
-def summaries(folder):
-    """Every summary.json below @p folder (one per load case)."""
-    result = {}
-    for path in sorted(glob.glob(os.path.join(folder, "**", "summary.json"),
-                                 recursive=True)):
-        with open(path) as f:
-            result[os.path.relpath(path, folder)] = json.load(f)
-    return result
+def below(folder, pattern, read):
+    """read(path) of every file matching @p pattern below @p folder (one per
+    load case), by its path relative to @p folder."""
+    return {os.path.relpath(path, folder): read(path)
+            for path in sorted(glob.glob(os.path.join(folder, "**", pattern),
+                                         recursive=True))}
 
 
-def displacements(folder):
-    """The point displacements of every solution.vtu below @p folder."""
-    fields = {}
-    for path in sorted(glob.glob(os.path.join(folder, "**", "solution.vtu"),
-                                 recursive=True)):
-        reader = vtk.vtkXMLUnstructuredGridReader()
-        reader.SetFileName(path)
-        reader.Update()
-        data = reader.GetOutput().GetPointData().GetArray("displacement")
-        fields[os.path.relpath(path, folder)] = vtk_to_numpy(data)
-    return fields
+def read_json(path):
+    with open(path) as f:
+        return json.load(f)
 
 
-def tables(folder):
-    """The rows of every contact CSV below @p folder."""
-    result = {}
-    for path in sorted(glob.glob(os.path.join(folder, "**", "contact_*.csv"),
-                                 recursive=True)):
-        with open(path) as f:
-            result[os.path.relpath(path, folder)] = list(csv.DictReader(f))
-    return result
+def read_displacement(path):
+    """The point displacements of a solution.vtu."""
+    reader = vtk.vtkXMLUnstructuredGridReader()
+    reader.SetFileName(path)
+    reader.Update()
+    return vtk_to_numpy(reader.GetOutput().GetPointData().GetArray(
+        "displacement"))
+
+
+def read_rows(path):
+    with open(path) as f:
+        return list(csv.DictReader(f))
 
 
 def compare_fields(name, one, many, failures):
     """Displacements and contact tables of two result folders; returns the
     largest relative difference."""
     worst = 0.0
-    u1, u2 = displacements(one), displacements(many)
+    u1 = below(one, "solution.vtu", read_displacement)
+    u2 = below(many, "solution.vtu", read_displacement)
     if not u1 or u1.keys() != u2.keys():
         failures.append("%s: solution.vtu files %s against %s" %
                         (name, sorted(u1), sorted(u2)))
@@ -192,7 +175,8 @@ def compare_fields(name, one, many, failures):
             if error > TOLERANCE:
                 failures.append("%s: %s displacement differs by %.1e of max "
                                 "|u|" % (name, path, error))
-    t1, t2 = tables(one), tables(many)
+    t1 = below(one, "contact_*.csv", read_rows)
+    t2 = below(many, "contact_*.csv", read_rows)
     if t1.keys() != t2.keys():
         failures.append("%s: contact CSVs %s against %s" %
                         (name, sorted(t1), sorted(t2)))
@@ -259,7 +243,8 @@ def compare_runs(binary, folder, name, text, ranks, failures):
                             (name, max(count, 1), result.returncode))
             return
         results[count] = out
-    one, many = summaries(results[0]), summaries(results[ranks])
+    one = below(results[0], "summary.json", read_json)
+    many = below(results[ranks], "summary.json", read_json)
     worst = 0.0
     for path, summary in many.items():
         if summary["solver"].get("ranks") != ranks:
