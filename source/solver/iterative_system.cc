@@ -54,10 +54,7 @@ namespace knee_contact
       double
       dot(const Vector<double> &x) const
       {
-        double value = 0;
-        for (const auto &[i, a] : w)
-          value += a * x(i);
-        return value;
+        return sparse_dot(w, x);
       }
     };
 

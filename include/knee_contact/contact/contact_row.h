@@ -14,6 +14,20 @@ namespace knee_contact
 {
   using namespace dealii;
 
+  /** sum_i c_i x_i over the (dof, coefficient) pairs @p entries. */
+  inline double
+  sparse_dot(
+    const std::vector<std::pair<types::global_dof_index, double>> &entries,
+    const Vector<double>                                          &x)
+  {
+    double value = 0;
+    for (const auto &[dof, coefficient] : entries)
+      value += coefficient * x(dof);
+    return value;
+  }
+
+
+
   /**
    * One row of the seed's contact constraint A x <= 0 (its eq. (13)), with
    * the initial gap: a_p . x <= g_p, as the solver sees it. It knows dofs and
@@ -84,10 +98,7 @@ namespace knee_contact
     double
     jump(const Vector<double> &x) const
     {
-      double value = 0;
-      for (const auto &[dof, coefficient] : row)
-        value += coefficient * x(dof);
-      return value;
+      return sparse_dot(row, x);
     }
   };
 
