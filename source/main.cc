@@ -15,7 +15,7 @@
 #include <system_error>
 
 // knee_contact: unilateral contact between linear elastic bodies in 2D and
-// 3D (the dimension comes from the mesh; friction in 2D).
+// 3D (the dimension comes from the mesh), on one process or under mpirun.
 // Usage: [mpirun -np N] knee_contact [--dry-run] scene.prm | --help |
 // --print-parameters
 namespace

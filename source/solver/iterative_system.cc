@@ -393,6 +393,10 @@ namespace knee_contact
     list.set("PDE equations", int(components));
     list.set("null space: type", "pre-computed");
     list.set("null space: dimension", int(n_modes));
+    // (A rank without rows passes an array all the same: a null pointer
+    // makes ML ignore the dimension, and warn.)
+    if (modes.empty())
+      modes.resize(1);
     list.set("null space: vectors", modes.data());
     amg.initialize(amg_matrix, list);
     has_amg = true;
