@@ -163,7 +163,7 @@ namespace knee_contact
     unsigned int
     ranks_on_this_machine()
     {
-      return n_ranks() == 1 ? 1 : ranks_sharing_memory;
+      return ranks_sharing_memory;
     }
 
 

@@ -827,10 +827,10 @@ namespace knee_contact
     // fine entry measured with plain aggregation: 150 MB for the knee's
     // 1.48e7 entries); the null space twice (ML's copy), the CG and operator
     // vectors and the condensed right hand side: about 22 vectors.
-    // Several ranks: each condenses the whole matrix (8 bytes an entry,
-    // freed) and holds its part of Trilinos' copy, of the current set's
-    // when the hierarchy is older, and of the hierarchy; the vectors stay
-    // whole (replicated).
+    // Several ranks: each keeps a deal.II matrix on the whole pattern for
+    // its condensed rows (8 bytes an entry) and holds its part of Trilinos'
+    // condensed matrix (12), of C (12, the operator's) and of the
+    // hierarchy (10); the vectors stay whole (replicated).
     const double ranks = parallel::n_ranks();
     if (ranks > 1)
       return 8. * nnz + (12. + 12. + 10.) * nnz / ranks + 8. * 22 * n;
