@@ -266,7 +266,7 @@ namespace knee_contact
 
   template <int dim>
   void
-  ContactProblem<dim>::make_mesh(const unsigned int level)
+  ContactProblem<dim>::make_mesh(const int level)
   {
     mesh_input.create(triangulation, level);
     fe =

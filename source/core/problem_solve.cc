@@ -34,6 +34,7 @@ namespace knee_contact
                                           : refinement.n_adaptive_cycles;
     Progress                 progress(
       log(), Refinement::name(strategy) + " cycle", n_cycles, true, 0);
+    previous_contact.clear();
     for (unsigned int cycle = 0; cycle < n_cycles; ++cycle)
       {
         CycleRecord record;
@@ -48,6 +49,13 @@ namespace knee_contact
           record.wall_time[phase] += clock.wall_time();
         };
 
+        double coarse_start_time = 0;
+        if (cycle == 0 && active_set_solver.coarse_start_levels() > 0 &&
+            !contact_interfaces.interfaces().empty())
+          timed("coarse start", [&]() {
+            coarse_start_time =
+              coarse_start(active_set_solver.coarse_start_levels());
+          });
         timed("mesh", [&]() {
           if (cycle == 0)
             make_mesh(0);
@@ -84,17 +92,9 @@ namespace knee_contact
         timed("solve", [&]() {
           // Warm start on a refined mesh: pairs within the previous contact
           // zone start active (the loop corrects the guess).
-          std::vector<bool> guess;
-          if (cycle > 0)
-            {
-              guess.assign(contact_pairs.size(), false);
-              for (unsigned int p = 0; p < contact_pairs.size(); ++p)
-                for (const auto &[position, length] : previous_contact)
-                  if (contact_pairs.points[p].position.distance(position) <=
-                      length)
-                    guess[p] = true;
-            }
-          solve_contact(guess, true);
+          solve_contact(previous_zone_guess(), true);
+          if (coarse_start_time > 0)
+            solver_figures["coarse_start"] = coarse_start_time;
         });
         timed("postprocess", [&]() {
           results       = current_results();
@@ -102,11 +102,7 @@ namespace knee_contact
             dof_handler, displacement, materials, contact_pairs, results);
         });
 
-        previous_contact.clear();
-        for (unsigned int p = 0; p < contact_pairs.size(); ++p)
-          if (contact_solution.active[p])
-            previous_contact.emplace_back(contact_pairs.points[p].position,
-                                          contact_pairs.rows[p].spacing(dim));
+        keep_contact_zone();
         record.n_cells        = triangulation.n_active_cells();
         record.n_dofs         = dof_handler.n_dofs();
         record.n_pairs        = contact_pairs.size();
@@ -249,6 +245,85 @@ namespace knee_contact
     for (const auto &[id, value] : results.von_mises_max)
       quantities[materials[id].name + ": von Mises max"] = value;
     return quantities;
+  }
+
+
+
+  template <int dim>
+  void
+  ContactProblem<dim>::keep_contact_zone()
+  {
+    previous_contact.clear();
+    for (unsigned int p = 0; p < contact_pairs.size(); ++p)
+      if (contact_solution.active[p])
+        previous_contact.emplace_back(contact_pairs.points[p].position,
+                                      contact_pairs.rows[p].spacing(dim));
+  }
+
+
+
+  template <int dim>
+  std::vector<bool>
+  ContactProblem<dim>::previous_zone_guess() const
+  {
+    // Pairs within a previous active pair's spacing start active (the loop
+    // corrects the guess); none known: the loop's own start.
+    std::vector<bool> guess;
+    if (previous_contact.empty())
+      return guess;
+    guess.assign(contact_pairs.size(), false);
+    for (unsigned int p = 0; p < contact_pairs.size(); ++p)
+      for (const auto &[position, length] : previous_contact)
+        if (contact_pairs.points[p].position.distance(position) <= length)
+          guess[p] = true;
+    return guess;
+  }
+
+
+
+  template <int dim>
+  double
+  ContactProblem<dim>::coarse_start(const unsigned int levels)
+  {
+    // Nested iteration: the active-set loop needs few iterations from a
+    // good guess, and many from the pairs that touch (on the Hertz sphere
+    // it releases a ring of pairs per iteration after the first solve
+    // pressed the sphere on one point); a mesh 2^3 times coarser per level
+    // finds the zone for a fraction of a solve on this one.
+    // The coarse meshes' solves take the path the automatic choice finds
+    // cheapest for them, whatever the scene asks for the run's own mesh.
+    mesh_input.check_coarser_levels(levels);
+    Timer      clock;
+    const auto path = active_set_solver.linear_solver();
+    active_set_solver.set_linear_solver(SolverPath::automatic);
+    previous_contact.clear();
+    for (int level = -int(levels); level < 0; ++level)
+      {
+        try
+          {
+            make_mesh(level);
+            setup_system();
+            ElasticityAssembler<dim> assembler(materials, boundary_conditions);
+            assembler.assemble(dof_handler, system_matrix, system_rhs);
+            solve_contact(previous_zone_guess(), true);
+          }
+        catch (const std::exception &exc)
+          {
+            std::cout << "coarse start level " << level
+                      << " skipped: " << input::one_line(exc.what())
+                      << std::endl;
+            previous_contact.clear();
+            break;
+          }
+        keep_contact_zone();
+        std::cout << "coarse start level " << level << ": "
+                  << triangulation.n_active_cells() << " cells, "
+                  << dof_handler.n_dofs() << " dofs, "
+                  << previous_contact.size() << " of " << contact_pairs.size()
+                  << " pairs active" << std::endl;
+      }
+    active_set_solver.set_linear_solver(path);
+    return clock.wall_time();
   }
 
 

@@ -271,11 +271,15 @@ namespace knee_contact
   template <int dim>
   void
   MeshInput<dim>::create(Triangulation<dim> &triangulation,
-                         const unsigned int  level) const
+                         const int           level) const
   {
     triangulation.clear();
+    // A level below 0 (the coarse start): a .geo meshed by gmsh at 2^-level
+    // times the size, other meshes -level fewer Global refinements.
+    const bool geo = source == Source::file &&
+                     std::filesystem::path(file).extension() == ".geo";
     if (source == Source::file)
-      read_file(triangulation, level);
+      read_file(triangulation, geo ? level : std::max(level, 0));
     else
       make_rectangles(triangulation);
     // Tetrahedra of a .geo are refined by gmsh (see remeshes()): Global
@@ -286,9 +290,15 @@ namespace knee_contact
         if (n_refinements > 0)
           {
             triangulation.clear();
-            read_file(triangulation, level + n_refinements);
+            read_file(triangulation, level + int(n_refinements));
           }
         n_refine = 0;
+      }
+    else if (level < 0 && !geo)
+      {
+        // coarser_levels() was asked first.
+        AssertThrow(int(n_refinements) + level >= 0, ExcInternalError());
+        n_refine = n_refinements + level;
       }
 
     AssertThrow(triangulation.n_active_cells() > 0,
@@ -329,6 +339,24 @@ namespace knee_contact
     triangulation.refine_global(n_refine);
     if (n_refine > 0)
       check_cells(triangulation);
+  }
+
+
+
+  template <int dim>
+  void
+  MeshInput<dim>::check_coarser_levels(const unsigned int levels) const
+  {
+    const bool geo = source == Source::file &&
+                     std::filesystem::path(file).extension() == ".geo";
+    AssertThrow(geo || levels <= n_refinements,
+                ExcMessage(
+                  "Contact/Coarse start levels: " + std::to_string(levels) +
+                  (levels == 1 ? " coarser level needs"
+                               : " coarser levels need") +
+                  " a .geo (gmsh meshes it coarser) or at least as "
+                  "many Mesh/Global refinements (this scene has " +
+                  std::to_string(n_refinements) + ")"));
   }
 
 

@@ -155,12 +155,12 @@ namespace knee_contact
 
   template <int dim>
   mesh_readers::Description<dim>
-  MeshInput<dim>::read_gmsh(const unsigned int level) const
+  MeshInput<dim>::read_gmsh(const int level) const
   {
     // Level L: the mesh size times 2^-L (gmsh's -clscale, on top of one the
     // scene gives).
     std::vector<std::string> arguments = gmsh_arguments;
-    if (level > 0)
+    if (level != 0)
       {
         const double factor = std::pow(0.5, level);
         const auto   it =
@@ -213,7 +213,7 @@ namespace knee_contact
   template <int dim>
   void
   MeshInput<dim>::read_file(Triangulation<dim> &triangulation,
-                            const unsigned int  level) const
+                            const int           level) const
   {
     const std::string extension = std::filesystem::path(file).extension();
     AssertThrow(extension == ".inp" ||
@@ -285,14 +285,11 @@ namespace knee_contact
         if (simplices && (others || split_triangles || adaptive))
           mesh_readers::split_into_quadrilaterals(mesh, circular_boundaries);
       }
-    else
-      AssertThrow(!simplices || !adaptive,
-                  ExcMessage("Refinement/Strategy: a tetrahedral mesh cannot "
-                             "be refined adaptively (deal.II 9.4 has no "
-                             "hanging nodes on simplices); use global "
-                             "refinement or a hexahedral mesh"));
     try
       {
+        if constexpr (dim == 3)
+          if (simplices && (others || adaptive))
+            mesh_readers::split_into_hexahedra(mesh);
         triangulation.create_triangulation(mesh.vertices,
                                            mesh.cells,
                                            mesh.subcells);
@@ -434,14 +431,14 @@ namespace knee_contact
 
 
 
-#define KNEE_CONTACT_INSTANTIATE(dim)                                        \
-  template mesh_readers::Description<dim> MeshInput<dim>::read_gmsh(         \
-    const unsigned int) const;                                               \
-  template void MeshInput<dim>::read_file(Triangulation<dim> &,              \
-                                          const unsigned int) const;         \
-  template void MeshInput<dim>::finish(mesh_readers::Description<dim> &,     \
-                                       Triangulation<dim> &) const;          \
-  template void MeshInput<dim>::make_rectangles(Triangulation<dim> &) const; \
+#define KNEE_CONTACT_INSTANTIATE(dim)                                          \
+  template mesh_readers::Description<dim> MeshInput<dim>::read_gmsh(const int) \
+    const;                                                                     \
+  template void MeshInput<dim>::read_file(Triangulation<dim> &, const int)     \
+    const;                                                                     \
+  template void MeshInput<dim>::finish(mesh_readers::Description<dim> &,       \
+                                       Triangulation<dim> &) const;            \
+  template void MeshInput<dim>::make_rectangles(Triangulation<dim> &) const;   \
   template void MeshInput<dim>::make_rectangles_2d(Triangulation<2> &) const;
   KNEE_CONTACT_INSTANTIATE(2)
   KNEE_CONTACT_INSTANTIATE(3)

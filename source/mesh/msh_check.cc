@@ -230,23 +230,18 @@ namespace knee_contact
           }
       }
 
-      // The cells' dimension (the highest element dimension); refuses
-      // tetrahedra beside hexahedra, which no conforming mesh joins without
-      // pyramids.
+      // The cells' dimension (the highest element dimension). Tetrahedra
+      // beside hexahedra are read: MeshInput splits such a mesh into
+      // hexahedra.
       struct CellKinds
       {
-        unsigned int dimension  = 0;
-        bool         tetrahedra = false, hexahedra = false;
+        unsigned int dimension = 0;
 
         void
         add(const long long type, const MshReader &reader)
         {
           dimension =
             std::max(dimension, nodes_and_dimension(type, reader).second);
-          (type == 4 ? tetrahedra : hexahedra) |= type == 4 || type == 5;
-          if (tetrahedra && hexahedra)
-            reader.fail("the mesh has tetrahedra and hexahedra; a 3D mesh "
-                        "must have cells of one kind");
         }
       };
 

@@ -138,24 +138,27 @@ namespace knee_contact
   namespace
   {
     /**
-     * u.n = 0 on the sliding boundary @p ids of a 3D mesh with tetrahedra
-     * (linear elements: vertex dofs only). Written by hand because deal.II
-     * 9.4's compute_no_normal_flux_constraints() assumes that a cell at an
-     * edge or corner of the boundary has a face on each side of it (true
-     * of hexahedra): on tetrahedra a cell often touches an edge with one
-     * face, the normals of the two sides are then averaged and only their
-     * mean direction constrained (measured: a block sliding on three
-     * planes off by 20 %), and its normal vector of a triangle is computed
-     * as of a quadrilateral. Here the normals at a vertex are grouped into
-     * surfaces: faces of one boundary id whose normals are within 45
-     * degrees of the group's mean are one (smooth) surface, other ids and
-     * sharper angles are others; one surface constrains u.n = 0, two
+     * u.n = 0 on the sliding boundary @p ids of a 3D mesh (linear elements:
+     * vertex dofs only). Written by hand because deal.II 9.4's
+     * compute_no_normal_flux_constraints() assumes that a cell at an edge
+     * or corner of the boundary has a face on each side of it (true of
+     * structured hexahedra): on tetrahedra, and on hexahedra made of them
+     * or of an unstructured mesher's, a cell often touches an edge with
+     * one face, the normals of the two sides are then averaged and only
+     * their mean direction constrained (measured: a block sliding on three
+     * planes off by 20 % with tetrahedra, 19 % with tetrahedra split into
+     * hexahedra), and its normal vector of a triangle is computed as of a
+     * quadrilateral. Hanging vertices get lines here too, which the
+     * hanging-node constraints made before override. Here the normals at a
+     * vertex are grouped into surfaces: faces of one boundary id whose normals
+     * are within 45 degrees of the group's mean are one (smooth) surface, other
+     * ids and sharper angles are others; one surface constrains u.n = 0, two
      * constrain u to their edge's direction, three or more fix u.
      */
     void
-    sliding_constraints_on_simplices(const DoFHandler<3> &dof_handler,
-                                     const std::set<types::boundary_id> &ids,
-                                     AffineConstraints<double> &constraints)
+    sliding_constraints_3d(const DoFHandler<3>                &dof_handler,
+                           const std::set<types::boundary_id> &ids,
+                           AffineConstraints<double>          &constraints)
     {
       struct Surface
       {
@@ -286,17 +289,9 @@ namespace knee_contact
     if (!sliding.empty())
       {
         AffineConstraints<double> sliding_constraints;
-        bool                      done = false;
         if constexpr (dim == 3)
-          if (!dof_handler.get_triangulation()
-                 .all_reference_cells_are_hyper_cube())
-            {
-              sliding_constraints_on_simplices(dof_handler,
-                                               sliding,
-                                               sliding_constraints);
-              done = true;
-            }
-        if (!done)
+          sliding_constraints_3d(dof_handler, sliding, sliding_constraints);
+        else
           VectorTools::compute_no_normal_flux_constraints(dof_handler,
                                                           0,
                                                           sliding,

@@ -82,6 +82,15 @@ namespace knee_contact
                       "Iterative path: CG iterations allowed per solve; "
                       "more ends the run with an error.",
                       Patterns::Integer(1));
+    prm.add_parameter(
+      "Coarse start levels",
+      coarse_levels,
+      "Before the first cycle, solve the contact problem on the mesh this "
+      "many levels coarser (a .geo of tetrahedra meshed by gmsh at 2^k "
+      "times its size, else k fewer Global refinements) and start the loop "
+      "from its contact zone; the loop's iterations then mostly fall away "
+      "(doc/performance.md). 0: start from the pairs that touch.",
+      Patterns::Integer(0, 3));
     prm.add_parameter("Reference solve",
                       reference_solve,
                       "After the contact solve, time one linear solve of the "

@@ -9,7 +9,9 @@
    to 1e-12 relative to the largest of its kind.
 2. A deck written here from the Abaqus keywords' documented layout: one
    *Part BLOCK (a 1 x 1 x 2 box of 2 x 2 x 4 hexahedra, or of the same
-   hexahedra split into six tetrahedra each), two *Instance of it in an
+   hexahedra split into six tetrahedra each; a third deck has one part of
+   each kind, which knee_contact solves with its tetrahedra split into
+   hexahedra), two *Instance of it in an
    *Assembly: B1 where the part is, B2 translated by (3, 0, 0) and rotated
    by 40 degrees about the axis from (4, 1, 1) to (5, 3, 4); surfaces of
    element faces (S1-S6, tetrahedra S1-S4) and node sets of the part,
@@ -163,11 +165,13 @@ def faces_on(nodes, elements, plane):
 
 
 def write_deck(path, tets):
+    """tets: per instance (B1, B2), whether its part is of tetrahedra."""
     with open(path, "w") as f:
         f.write("*Heading\n** two parts and their instances, written by "
                 "abaqus_3d.py\n")
-        for instance, (material, E, nu) in MATERIALS.items():
-            write_part(f, "Part" + instance, material, tets)
+        for (instance, (material, E, nu)), part_tets in zip(
+                MATERIALS.items(), tets):
+            write_part(f, "Part" + instance, material, part_tets)
         f.write("**\n*Assembly, name=Assembly\n")
         f.write("*Instance, name=B1, part=PartB1\n*End Instance\n")
         f.write("*Instance, name=B2, part=PartB2\n%g, %g, %g\n"
@@ -231,7 +235,7 @@ def rotation():
              for j in range(3)] for i in range(3)]
 
 
-def two_instance_scene(deck, tets):
+def two_instance_scene(deck):
     R = rotation()
     c = AXIS[0]
     # Block 2's exact solution as A X + b.
@@ -338,11 +342,14 @@ def main():
             other = run(binary, bonded_scene(inp, sets), folder,
                         kind + "_gmsh_inp")
             failures += compare("gmsh .inp, " + kind, reference, other)
-        for tets in (False, True):
-            name = "parts_" + ("tetrahedra" if tets else "hexahedra")
+        # The third deck has both kinds (hexahedra below, tetrahedra
+        # above): knee_contact splits its tetrahedra into hexahedra.
+        for name, tets in (("parts_hexahedra", (False, False)),
+                           ("parts_tetrahedra", (True, True)),
+                           ("parts_hexahedra_and_tetrahedra", (False, True))):
             deck = os.path.join(folder, name + ".inp")
             write_deck(deck, tets)
-            run(binary, two_instance_scene(deck, tets), folder, name)
+            run(binary, two_instance_scene(deck), folder, name)
             print("%s: analytic checks passed" % name)
     if failures:
         raise SystemExit("%d differences" % failures)

@@ -58,6 +58,8 @@ EXEMPT = [
     ("uniaxial_block_3d_tet.prm", r"^geometry:", "as uniaxial_block.prm"),
     ("uniaxial_block_3d_tet_sliding.prm", r"^geometry:",
      "as uniaxial_block.prm"),
+    ("uniaxial_block_3d_tet_adaptive.prm", r"^geometry:",
+     "as uniaxial_block.prm"),
     ("manufactured_convergence_3d_tet.prm", r"^(nu|load):",
      "the tetrahedral meshes of the rate test stay coarse (finest relative "
      "L2 error 1.75e-2): a 1 % error of nu or of the body force adds less "

@@ -125,12 +125,12 @@ def main():
             files[suffix] = os.path.join(folder, "mesh" + suffix)
             mesh_formats.write_vtu(files[suffix], nodes, cells, lines,
                                    encoding)
-        # The 3D two-part deck (hexahedra, skew rotation, *Elastic) with
-        # its own scene.
+        # The 3D two-part deck (hexahedra and tetrahedra, which are split
+        # into hexahedra; skew rotation, *Elastic) with its own scene.
         deck_3d = os.path.join(folder, "mesh_3d_parts.inp")
-        abaqus_3d.write_deck(deck_3d, False)
+        abaqus_3d.write_deck(deck_3d, (False, True))
         scene_3d = abaqus_3d.two_instance_scene(
-            "@WORK@/mesh.inp", False).replace("@FOLDER@", "@WORK@/out")
+            "@WORK@/mesh.inp").replace("@FOLDER@", "@WORK@/out")
         for _ in range(per_file):
             damaged, what = damage(open(deck_3d, "rb").read(), rng)
             cases.append(("mesh_3d_parts.inp: %s" % what, scene_3d,

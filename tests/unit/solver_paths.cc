@@ -187,12 +187,15 @@ main()
                           "../../prm/hard/thin_layer.prm",
                           "../../prm/hard/zero_load.prm"};
   // 3D: the contact patch tests (mortar on hexahedra and tetrahedra,
-  // rotated; node-to-segment, node-to-node) and the Hertz sphere (an active
-  // set found from a point contact over several iterations).
+  // rotated, and across the two kinds; node-to-segment, node-to-node) and the
+  // Hertz sphere (an active set found from a point contact over several
+  // iterations).
   const char *scenes_3d[] = {"../scenes/contact_patch_3d_hex.prm",
                              "../scenes/contact_patch_3d_hex_rotated.prm",
                              "../scenes/contact_patch_3d_tet.prm",
                              "../scenes/contact_patch_3d_tet_rotated.prm",
+                             "../scenes/contact_patch_3d_hex_on_tet.prm",
+                             "../scenes/contact_patch_3d_tet_on_hex.prm",
                              "../scenes/contact_patch_3d_matching.prm",
                              "../scenes/contact_patch_3d_nodes.prm",
                              "../scenes/hertz_sphere_3d_small.prm"};

@@ -157,6 +157,19 @@ namespace knee_contact
     void
     check_name(const std::string &name, const std::string &parameter);
   } // namespace input
+
+
+
+  /** A point in a message: "(x, y)" or "(x, y, z)". */
+  template <int dim>
+  std::string
+  point_text(const Point<dim> &point)
+  {
+    std::string text = "(";
+    for (unsigned int d = 0; d < dim; ++d)
+      text += (d ? ", " : "") + input::format(point[d]);
+    return text + ")";
+  }
 } // namespace knee_contact
 
 #endif

@@ -89,19 +89,6 @@ namespace knee_contact
 
 
 
-  /** A point in a message: "(x, y)" or "(x, y, z)". */
-  template <int dim>
-  std::string
-  point_text(const Point<dim> &point)
-  {
-    std::string text = "(";
-    for (unsigned int d = 0; d < dim; ++d)
-      text += (d ? ", " : "") + input::format(point[d]);
-    return text + ")";
-  }
-
-
-
   /**
    * Where the slave normal n from x meets the master side: x + s n is the
    * master face's point at parameter xi (2D: p0 + xi (p1 - p0)), the

@@ -69,6 +69,21 @@ namespace knee_contact
       return {0, 1, 3, 2};
     }
 
+    /**
+     * Whether the face's map is affine: a triangle, or a parallelogram
+     * (x0 + x3 = x1 + x2 up to 1e-12 of its size). Only then are the
+     * face's shape functions polynomials of the position in a plane.
+     */
+    inline bool
+    is_affine(const Face &face)
+    {
+      if (face.n_vertices == 3)
+        return true;
+      const auto  &x    = face.vertices;
+      const double size = (x[3] - x[0]).norm() + (x[2] - x[1]).norm();
+      return (x[0] + (x[3] - x[1]) - x[2]).norm() <= 1e-12 * size;
+    }
+
     /** The reference point of the face's centre. */
     inline Point<2>
     centre_xi(const Face &face)

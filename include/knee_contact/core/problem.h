@@ -190,7 +190,7 @@ namespace knee_contact
      * mesh input remeshes instead of refining (MeshInput::remeshes()).
      */
     void
-    make_mesh(const unsigned int level);
+    make_mesh(const int level);
 
     void
     setup_system();
@@ -204,6 +204,27 @@ namespace knee_contact
     run_cycles(const Refinement::Strategy strategy,
                TimerOutput               &timer,
                Results<dim>              &results);
+
+    /**
+     * Contact/Coarse start levels: solve on the meshes @p levels, ..., 1
+     * levels coarser than the first cycle's, each from the previous one's
+     * contact zone, and leave the last zone in previous_contact as the
+     * first cycle's guess. Returns the time it took. A coarser mesh that
+     * cannot be made or solved only costs the guess (said in the log).
+     */
+    double
+    coarse_start(const unsigned int levels);
+
+    /** The active pairs' places and spacings, kept in previous_contact. */
+    void
+    keep_contact_zone();
+
+    /**
+     * The pairs within a kept active pair's spacing (the previous mesh's
+     * contact zone); empty if none is kept.
+     */
+    std::vector<bool>
+    previous_zone_guess() const;
 
     /**
      * Solve the contact problem for the current system_rhs, from the active

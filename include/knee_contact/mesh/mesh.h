@@ -87,8 +87,7 @@ namespace knee_contact
      * globally as asked.
      */
     void
-    create(Triangulation<dim> &triangulation,
-           const unsigned int  level = 0) const;
+    create(Triangulation<dim> &triangulation, const int level = 0) const;
 
     /**
      * Whether refinement cycles remesh instead of refining @p triangulation:
@@ -98,6 +97,14 @@ namespace knee_contact
      */
     bool
     remeshes(const Triangulation<dim> &triangulation) const;
+
+    /**
+     * Refuse, naming Contact/Coarse start levels, @p levels coarser meshes
+     * that create() cannot make (level -levels): a .geo can be meshed
+     * coarser by gmsh, other meshes have Global refinements to leave out.
+     */
+    void
+    check_coarser_levels(const unsigned int levels) const;
 
     /**
      * The elastic constants the Abaqus deck Mesh/File gives each material
@@ -127,12 +134,11 @@ namespace knee_contact
      * quadrilaterals, adaptive refinement).
      */
     void
-    read_file(Triangulation<dim> &triangulation,
-              const unsigned int  level) const;
+    read_file(Triangulation<dim> &triangulation, const int level) const;
 
     /** The Gmsh mesh at refinement @p level (see remeshes()). */
     mesh_readers::Description<dim>
-    read_gmsh(const unsigned int level) const;
+    read_gmsh(const int level) const;
 
     /**
      * Split @p mesh's triangles where needed (see read_file) and make

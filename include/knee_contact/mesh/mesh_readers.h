@@ -15,8 +15,9 @@ namespace knee_contact
 
   /**
    * Mesh files other than Gmsh's, made safe before anything builds a mesh of
-   * them, and the one step that turns triangles into quadrilaterals where
-   * the solver needs them. Every error names the file and line.
+   * them, and the one step that turns triangles into quadrilaterals (and
+   * tetrahedra into hexahedra) where the solver needs them. Every error names
+   * the file and line.
    */
   namespace mesh_readers
   {
@@ -131,6 +132,20 @@ namespace knee_contact
     split_into_quadrilaterals(
       Description<2>                               &mesh,
       const std::map<types::boundary_id, Point<2>> &circles);
+
+    /**
+     * Split every tetrahedron into four hexahedra (one at each corner: the
+     * corner, the midpoints of its three edges, the centroids of its three
+     * faces and the cell's centroid; every face of the pieces is plane)
+     * and, if a hexahedron has an edge of a tetrahedron, every hexahedron
+     * into eight at its centre, so that the mesh stays conforming; the
+     * boundary faces and edges with ids are split with them. The 3D
+     * fallback for meshes of both kinds (deal.II 9.4 has no element for
+     * tetrahedra and hexahedra in one mesh without an hp::FECollection) and
+     * for tetrahedral meshes refined adaptively.
+     */
+    void
+    split_into_hexahedra(Description<3> &mesh);
   } // namespace mesh_readers
 } // namespace knee_contact
 

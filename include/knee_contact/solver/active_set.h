@@ -155,6 +155,16 @@ namespace knee_contact
       return reference_solve;
     }
 
+    /**
+     * Contact/Coarse start levels: how many levels coarser a mesh the
+     * first cycle's active set is guessed on (0: none).
+     */
+    unsigned int
+    coarse_start_levels() const
+    {
+      return coarse_levels;
+    }
+
     /** The iterative path's settings. */
     const KrylovSettings &
     krylov_settings() const
@@ -296,6 +306,7 @@ namespace knee_contact
     bool           safeguard       = true;
     LinearSolver   solver          = LinearSolver::automatic;
     bool           reference_solve = false;
+    unsigned int   coarse_levels   = 0;
     KrylovSettings krylov;
   };
 } // namespace knee_contact
