@@ -46,7 +46,8 @@ def draw(folder):
         line, = axes[1].plot(t, [float(r[name + measure]) * scale
                                  for r in rows], "o-", ms=3, label=name)
         if name in friction:
-            axes[1].plot(t, [float(r[name + "_stick_length"]) * 1e3
+            stick = "_stick_area" if three_d else "_stick_length"
+            axes[1].plot(t, [float(r[name + stick]) * scale
                              for r in rows], "--", color=line.get_color(),
                          label=name + ": sticking")
     for name in friction:

@@ -288,8 +288,8 @@ namespace knee_contact
     // Nested iteration: the active-set loop needs few iterations from a
     // good guess, and many from the pairs that touch (on the Hertz sphere
     // it releases a ring of pairs per iteration after the first solve
-    // pressed the sphere on one point); a mesh 2^3 times coarser per level
-    // finds the zone for a fraction of a solve on this one.
+    // pressed the sphere on one point); a mesh with 2^dim times fewer
+    // cells per level finds the zone for a fraction of a solve on this one.
     // The coarse meshes' solves take the path the automatic choice finds
     // cheapest for them, whatever the scene asks for the run's own mesh.
     mesh_input.check_coarser_levels(levels);

@@ -387,6 +387,13 @@ namespace knee_contact
             entry["slip_length"]          = i.slip_length;
             entry["max_slip"]             = i.max_slip;
             entry["max_accumulated_slip"] = i.max_accumulated_slip;
+            // As contact_area: the same shares named for what they are in
+            // 3D.
+            if (dim == 3)
+              {
+                entry["stick_area"] = i.stick_length;
+                entry["slip_area"]  = i.slip_length;
+              }
           }
       }
     // How each bar was made (estimate_errors()).

@@ -246,7 +246,8 @@ def run(binary, text, folder, name, expect_success=True):
 # What numbers() leaves out by default (see there).
 NOT_COMPARED = ("wall_time", "solver", "tangential_force_on_slave",
                 "n_stick", "n_slip", "max_slip", "stick_length",
-                "slip_length", "max_accumulated_slip",
+                "slip_length", "stick_area", "slip_area",
+                "max_accumulated_slip",
                 "active_set_iterations", "error_estimates",
                 "max_pressure_error", "energy_error", "force_error",
                 "min_error", "max_error", "peak_location")

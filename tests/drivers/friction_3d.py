@@ -18,7 +18,9 @@
    tangential load skew to every mesh axis (angle 0.3 rad from x, ratio
    r = 0.2 of the normal load), non-matching meshes (4 cells a side below,
    3 above): with mu = 0.5 > r the interface force on the slave balances
-   the load to 1e-8 relative (node-to-segment and mortar); with
+   the load to 1e-8 relative (node-to-segment and mortar), and
+   summary.json's stick_area + slip_area is its contact_area to 1e-12;
+   with
    mu = 0.1 < r the run is refused in one line naming the ratio 0.2.
 4. The same on a tilted interface: the stack rotated by 0.7 rad about the
    skew axis (1, 2, 3) with the load rotated along (a tangential ratio
@@ -220,6 +222,16 @@ def main():
                                      interface["n_stick"], interface["n_slip"],
                                      iterations(summary)))
                             failures += error > 1e-8
+                            # The sticking and slipping areas make up the
+                            # contact area (every active pair is one).
+                            shares = (interface["stick_area"] +
+                                      interface["slip_area"])
+                            if abs(shares - interface["contact_area"]) > \
+                                    1e-12 * interface["contact_area"]:
+                                print("  stick + slip area %.17g, contact "
+                                      "area %.17g" % (
+                                          shares, interface["contact_area"]))
+                                failures += 1
                         difference = max(
                             abs(found[other][key] -
                                 found["sparse"][key]) / abs(
