@@ -8,16 +8,20 @@
 #include <knee_contact/physics/elasticity.h>
 #include <knee_contact/physics/rigid_modes.h>
 
+#include <deal.II/base/bounding_box.h>
 #include <deal.II/base/timer.h>
 #include <deal.II/base/utilities.h>
 
 #include <deal.II/lac/sparse_direct.h>
+
+#include <deal.II/numerics/rtree.h>
 
 #include <array>
 #include <cmath>
 #include <functional>
 #include <iomanip>
 #include <iostream>
+#include <iterator>
 #include <new>
 
 namespace knee_contact
@@ -267,15 +271,39 @@ namespace knee_contact
   ContactProblem<dim>::previous_zone_guess() const
   {
     // Pairs within a previous active pair's spacing start active (the loop
-    // corrects the guess); none known: the loop's own start.
+    // corrects the guess); none known: the loop's own start. The kept
+    // pairs' reach as boxes in deal.II's RTree: each pair asks for the
+    // boxes it lies in (comparing every pair with every kept one was
+    // quadratic: 0.1 s at 1.4e4 x 3e3 pairs).
     std::vector<bool> guess;
     if (previous_contact.empty())
       return guess;
+    std::vector<std::pair<BoundingBox<dim>, unsigned int>> reach;
+    for (unsigned int k = 0; k < previous_contact.size(); ++k)
+      {
+        const auto &[position, length] = previous_contact[k];
+        Point<dim> low = position, high = position;
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            low[d] -= length;
+            high[d] += length;
+          }
+        reach.emplace_back(BoundingBox<dim>({low, high}), k);
+      }
+    const auto tree = pack_rtree(reach);
     guess.assign(contact_pairs.size(), false);
+    std::vector<std::pair<BoundingBox<dim>, unsigned int>> near;
     for (unsigned int p = 0; p < contact_pairs.size(); ++p)
-      for (const auto &[position, length] : previous_contact)
-        if (contact_pairs.points[p].position.distance(position) <= length)
-          guess[p] = true;
+      {
+        const Point<dim> &x = contact_pairs.points[p].position;
+        near.clear();
+        tree.query(boost::geometry::index::intersects(x),
+                   std::back_inserter(near));
+        for (const auto &[box, k] : near)
+          if (x.distance(previous_contact[k].first) <=
+              previous_contact[k].second)
+            guess[p] = true;
+      }
     return guess;
   }
 
