@@ -118,10 +118,9 @@ namespace knee_contact
             << (dim == 2 ? "_contact_length" : "_contact_area");
         if (i.friction)
           // In 3D the sticking and slipping shares are areas.
-          out << ',' << i.name
-              << (dim == 2 ? "_stick_length," : "_stick_area,") << i.name
-              << (dim == 2 ? "_slip_length," : "_slip_area,") << i.name
-              << "_max_slip," << i.name << "_max_accumulated_slip";
+          out << ',' << i.name << (dim == 2 ? "_stick_length," : "_stick_area,")
+              << i.name << (dim == 2 ? "_slip_length," : "_slip_area,")
+              << i.name << "_max_slip," << i.name << "_max_accumulated_slip";
       }
     out << '\n' << std::setprecision(12);
     for (unsigned int c = 0; c < records.size(); ++c)
