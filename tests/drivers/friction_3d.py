@@ -27,6 +27,8 @@
    0.8 mu and 1.2 mu in the interface's frame, mu = 0.3): below, the
    interface force balances the load to 1e-8; above, one line refuses it
    naming the ratio 1.2 x 0.3 = 0.36.
+5. The tilted held case with pictures on: pressure_block.png and
+   friction_block.png (the stick/slip map) are written.
 Each held case runs on the automatic path (condensed: the semismooth Newton
 step, 9-10 iterations), on the sparse one (which takes no springs: the
 Anderson-accelerated fixed point on the slip forces, 19-62 iterations; the
@@ -260,6 +262,20 @@ def main():
                            "names the ratio" if ok else "WRONG",
                            lines[-1] if lines else ""))
                     failures += not ok
+        # 5. The pictures of a frictional 3D interface: the pressure map
+        # and the stick/slip map (scripts/plot_results_3d.py) are written.
+        R = rotation(0.7)
+        local = (0.24 * G * math.cos(skew), 0.24 * G * math.sin(skew), -G)
+        load = tuple(sum(R[i][j] * local[j] for j in range(3))
+                     for i in range(3))
+        text = stack(load, folder, "pictures", mu=0.3, angle=0.7).replace(
+            "set Pictures = false", "set Pictures = true")
+        run(binary, text, folder, "pictures")
+        for picture in ("pressure_block.png", "friction_block.png"):
+            path = os.path.join(folder, "pictures", picture)
+            ok = os.path.exists(path) and os.path.getsize(path) > 0
+            print("picture %s: %s" % (picture, "written" if ok else "MISSING"))
+            failures += not ok
     print("PASS" if failures == 0 else "FAIL: %d checks" % failures)
     return 1 if failures else 0
 
