@@ -127,11 +127,7 @@ def pressure_map(folder, interface):
     # The contact zone and a margin of half its size (the whole side if
     # nothing is in contact).
     zone = active > 0.5 if active.any() else np.ones(len(rows), bool)
-    for values, limits in ((s, axes.set_xlim), (t, axes.set_ylim)):
-        low, high = values[zone].min(), values[zone].max()
-        margin = 0.5 * max(high - low, 1e-9 * max(np.ptp(s), np.ptp(t), 1))
-        limits((low - margin) * 1e3, (high + margin) * 1e3)
-    axes.set_aspect("equal")
+    zoom(axes, s, t, zone)
     axes.set_xlabel("e1 [mm]")
     axes.set_ylabel("e2 [mm]")
     figure.colorbar(filled, ax=axes, label="contact pressure [MPa]")
@@ -143,6 +139,16 @@ def pressure_map(folder, interface):
                               ".png"))
     if "status" in rows[0]:
         friction_map(folder, interface, rows, s, t, e1, e2, normal, zone)
+
+
+def zoom(axes, s, t, zone):
+    """The vertices of @p zone and a margin of half its size, in mm, at
+    equal scales."""
+    for values, limits in ((s, axes.set_xlim), (t, axes.set_ylim)):
+        low, high = values[zone].min(), values[zone].max()
+        margin = 0.5 * max(high - low, 1e-9 * max(np.ptp(s), np.ptp(t), 1))
+        limits((low - margin) * 1e3, (high + margin) * 1e3)
+    axes.set_aspect("equal")
 
 
 def friction_map(folder, interface, rows, s, t, e1, e2, normal, zone):
@@ -166,11 +172,7 @@ def friction_map(folder, interface, rows, s, t, e1, e2, normal, zone):
                     color="tab:red", angles="xy", width=0.004,
                     label="slip (largest %.3g m)"
                     % np.linalg.norm(slip[slipping], axis=1).max())
-    for values, limits in ((s, axes.set_xlim), (t, axes.set_ylim)):
-        low, high = values[zone].min(), values[zone].max()
-        margin = 0.5 * max(high - low, 1e-9 * max(np.ptp(s), np.ptp(t), 1))
-        limits((low - margin) * 1e3, (high + margin) * 1e3)
-    axes.set_aspect("equal")
+    zoom(axes, s, t, zone)
     axes.set_xlabel("e1 [mm]")
     axes.set_ylabel("e2 [mm]")
     axes.legend(loc="upper right", fontsize=8)
