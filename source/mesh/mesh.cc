@@ -276,8 +276,7 @@ namespace knee_contact
     triangulation.clear();
     // A level below 0 (the coarse start): a .geo meshed by gmsh at 2^-level
     // times the size, other meshes -level fewer Global refinements.
-    const bool geo = source == Source::file &&
-                     std::filesystem::path(file).extension() == ".geo";
+    const bool geo = from_geo();
     if (source == Source::file)
       read_file(triangulation, geo ? level : std::max(level, 0));
     else
@@ -347,9 +346,7 @@ namespace knee_contact
   void
   MeshInput<dim>::check_coarser_levels(const unsigned int levels) const
   {
-    const bool geo = source == Source::file &&
-                     std::filesystem::path(file).extension() == ".geo";
-    AssertThrow(geo || levels <= n_refinements,
+    AssertThrow(from_geo() || levels <= n_refinements,
                 ExcMessage(
                   "Contact/Coarse start levels: " + std::to_string(levels) +
                   (levels == 1 ? " coarser level needs"
@@ -363,6 +360,16 @@ namespace knee_contact
 
   template <int dim>
   bool
+  MeshInput<dim>::from_geo() const
+  {
+    return source == Source::file &&
+           std::filesystem::path(file).extension() == ".geo";
+  }
+
+
+
+  template <int dim>
+  bool
   MeshInput<dim>::remeshes(const Triangulation<dim> &triangulation) const
   {
     // deal.II 9.4 cuts every tetrahedron's inner octahedron along the same
@@ -370,9 +377,7 @@ namespace knee_contact
     // fixed in 9.6): measured on the unit cube, the P1 L2 rate fell from
     // 2.2 to 1.37 over three levels and the energy rate to 0.77. gmsh
     // meshing the .geo anew at half the size keeps the quality.
-    return dim == 3 && source == Source::file &&
-           std::filesystem::path(file).extension() == ".geo" &&
-           triangulation.n_active_cells() > 0 &&
+    return dim == 3 && from_geo() && triangulation.n_active_cells() > 0 &&
            triangulation.all_reference_cells_are_simplex();
   }
 

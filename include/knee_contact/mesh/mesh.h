@@ -98,6 +98,10 @@ namespace knee_contact
     bool
     remeshes(const Triangulation<dim> &triangulation) const;
 
+    /** Whether the mesh is a .geo that gmsh meshes (at any size). */
+    bool
+    from_geo() const;
+
     /**
      * Refuse, naming Contact/Coarse start levels, @p levels coarser meshes
      * that create() cannot make (level -levels): a .geo can be meshed
