@@ -10,7 +10,8 @@
 // a change dd of the load (a fixed pseudo-random vector) changes
 // lambda_p by z . dd, to 1e-10. For every active pair of the node-to-
 // segment and the mortar scene, on each solver path (condensed, sparse,
-// step-41), which each do the extra solve their own way.
+// step-41, iterative), which each do the extra solve their own way (the
+// iterative one to about 1 %, started from the solution).
 
 #include <knee_contact/core/problem.h>
 
@@ -18,6 +19,7 @@
 
 #include "free_dofs.h"
 
+#include <cstdlib>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -38,11 +40,17 @@ namespace
       problem.run();
       std::cout.rdbuf(terminal);
     }
-    const auto        &K      = problem.matrix();
-    const auto        &f      = problem.rhs();
-    const auto        &pairs  = problem.pairs();
-    const auto        &active = problem.contact().active;
-    const auto        &lambda = problem.contact().lambda;
+    // The iterative path's influence solves stop when the residual of the
+    // change has fallen a hundredfold (ContactProblem::
+    // multiplier_influence): z and mu to a few per cent (measured here at
+    // most 1.2e-2 and 2.8e-2, relative to their largest entries); the
+    // direct paths are exact.
+    const double       tolerance = path == SolverPath::iterative ? 5e-2 : 1e-10;
+    const auto        &K         = problem.matrix();
+    const auto        &f         = problem.rhs();
+    const auto        &pairs     = problem.pairs();
+    const auto        &active    = problem.contact().active;
+    const auto        &lambda    = problem.contact().lambda;
     const FreeDofs     reduced(K, f, problem.base_constraints());
     const unsigned int n = K.m(), n_free = reduced.n_free;
 
@@ -110,12 +118,12 @@ namespace
         const double predicted = z * dd, actual = change(n_free + k);
         const double influence_error =
           std::abs(predicted - actual) / std::abs(actual);
-        const bool pass =
-          z_error <= 1e-10 && mu_error <= 1e-10 && influence_error <= 1e-10;
+        const bool pass = z_error <= tolerance && mu_error <= tolerance &&
+                          influence_error <= tolerance;
         std::cout << "  pair " << p << ": check z, mu and lambda_p's change "
-                  << "z . dd against the dense KKT solve to 1e-10: "
-                  << (pass ? "PASS" : "FAIL") << std::endl;
-        if (!pass)
+                  << "z . dd against the dense KKT solve to " << tolerance
+                  << ": " << (pass ? "PASS" : "FAIL") << std::endl;
+        if (!pass || std::getenv("KC_TEST_VERBOSE"))
           std::cout << "    errors " << z_error << ' ' << mu_error << ' '
                     << influence_error << std::endl;
         ok = ok && pass;
@@ -131,8 +139,10 @@ main()
 {
   bool ok = true;
   for (const char *scene : {"qp_scene.prm", "qp_scene_mortar.prm"})
-    for (const SolverPath path :
-         {SolverPath::condensed, SolverPath::sparse, SolverPath::step41})
+    for (const SolverPath path : {SolverPath::condensed,
+                                  SolverPath::sparse,
+                                  SolverPath::step41,
+                                  SolverPath::iterative})
       ok = check(scene, path) && ok;
   std::cout << (ok ? "all PASS" : "FAIL") << std::endl;
   return ok ? 0 : 1;

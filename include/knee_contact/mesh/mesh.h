@@ -140,9 +140,31 @@ namespace knee_contact
     void
     read_file(Triangulation<dim> &triangulation, const int level) const;
 
-    /** The Gmsh mesh at refinement @p level (see remeshes()). */
-    mesh_readers::Description<dim>
-    read_gmsh(const int level) const;
+    /**
+     * The Gmsh mesh at refinement @p level (see remeshes()), read by
+     * deal.II's GridIn into @p triangulation.
+     */
+    void
+    read_gmsh(const int level, Triangulation<dim> &triangulation) const;
+
+    /**
+     * Whether a mesh of simplices (@p simplices) and other cells
+     * (@p others) must be split into quadrilaterals or hexahedra (see
+     * read_file).
+     */
+    bool
+    needs_split(const bool simplices, const bool others) const;
+
+    /** The same for the cells of @p triangulation. */
+    bool
+    needs_split(const Triangulation<dim> &triangulation) const;
+
+    /**
+     * Whether a cell of @p triangulation has a negative measure (its
+     * vertices listed the wrong way round).
+     */
+    static bool
+    any_cell_inverted(const Triangulation<dim> &triangulation);
 
     /**
      * Split @p mesh's triangles where needed (see read_file) and make

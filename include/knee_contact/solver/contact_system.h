@@ -70,13 +70,27 @@ namespace knee_contact
     /**
      * Inexact solves (the iterative path): the following solves may stop
      * at a residual of @p relative times the right hand side's norm (the
-     * loop asks for little while the active set still changes); 0: solve
-     * to the path's final tolerance. Direct paths are always exact.
+     * loop asks for little while the active set still changes), or with
+     * @p of_start at @p relative times their start's residual (a solve
+     * that resolves a change of a known solution, started from it:
+     * start_from()); 0: solve to the path's final tolerance. Direct paths
+     * are always exact.
      */
     virtual void
-    set_accuracy(const double relative)
+    set_accuracy(const double relative, const bool of_start = false)
     {
       (void)relative;
+      (void)of_start;
+    }
+
+    /**
+     * The next solve starts from @p x (the iterative path's warm start,
+     * otherwise the last solve's solution; direct paths need none).
+     */
+    virtual void
+    start_from(const Vector<double> &x)
+    {
+      (void)x;
     }
 
     /**
@@ -406,7 +420,10 @@ namespace knee_contact
           std::vector<double>     &lambda) override;
 
     void
-    set_accuracy(const double relative) override;
+    set_accuracy(const double relative, const bool of_start = false) override;
+
+    void
+    start_from(const Vector<double> &x) override;
 
     /**
      * Springs enter the operator (k w w^T, applied, never formed), the
