@@ -116,26 +116,28 @@ namespace knee_contact
         rigid_modes.components(),
         krylov);
     };
+    // The iterative path alone (the scene asks for it, or no factor can be
+    // made): its own memory estimate must fit.
+    const auto only_iterative = [&](const std::string &reason) {
+      std::string  limit;
+      const double available = available_on_every_rank(limit);
+      const double bytes =
+        IterativeContactSystem::estimated_bytes(matrix.get_sparsity_pattern());
+      figures["estimated_iterative_MB"] = bytes / 1048576.;
+      figures["available_MB"]           = available / 1048576.;
+      AssertThrow(bytes <= 0.8 * available,
+                  ExcMessage("out of memory: the contact solve (iterative "
+                             "path: " +
+                             reason + ") needs about " + megabytes(bytes) +
+                             " more, but " + megabytes(available) +
+                             " are available (" + limit +
+                             "); use fewer refinement cycles, a coarser "
+                             "mesh or a machine with more memory"));
+      return iterative(reason);
+    };
     if (requested == SolverPath::iterative)
-      {
-        // No direct path is analysed: the memory test is the iterative
-        // path's own.
-        std::string  limit;
-        const double available = available_on_every_rank(limit);
-        const double bytes     = IterativeContactSystem::estimated_bytes(
-          matrix.get_sparsity_pattern());
-        figures["estimated_iterative_MB"] = bytes / 1048576.;
-        figures["available_MB"]           = available / 1048576.;
-        AssertThrow(bytes <= 0.8 * available,
-                    ExcMessage("out of memory: the contact solve (iterative "
-                               "path) needs about " +
-                               megabytes(bytes) + " more, but " +
-                               megabytes(available) + " are available (" +
-                               limit +
-                               "); use fewer refinement cycles, a coarser "
-                               "mesh or a machine with more memory"));
-        return iterative("as Contact/Solver says");
-      }
+      // No direct path is analysed.
+      return only_iterative("as Contact/Solver says");
 
     // Sizes of the condensed path: k contact unknowns (every free dof of
     // a row that can be active), P rows.
@@ -166,7 +168,27 @@ namespace knee_contact
     // The sparse path's ordering and symbolic analysis are needed for its
     // estimate and are its own first step; the condensed path reuses the
     // ordering with the contact unknowns moved last.
-    auto sparse = std::make_unique<SparseContactSystem>(matrix, base, pairs);
+    // A factor past CHOLMOD's 32-bit indices would not fit in memory
+    // either (2^31 entries take 20 GB): the iterative path, if it fits.
+    std::unique_ptr<SparseContactSystem> sparse;
+    Timer                                choice_clock;
+    try
+      {
+        sparse = std::make_unique<SparseContactSystem>(matrix, base, pairs);
+      }
+    catch (const sparse_cholesky::FactorTooLarge &too_large)
+      {
+        figures["choice_analysis"] = choice_clock.wall_time();
+        return only_iterative(too_large.what());
+      }
+    // The ordering and analysis made for the choice are part of the
+    // solve's cost whichever path is taken (the sparse path reports them
+    // itself).
+    const auto keep_choice_figures = [&]() {
+      auto sparse_figures        = sparse->statistics();
+      figures["choice_ordering"] = sparse_figures["ordering"];
+      figures["choice_analysis"] = sparse_figures["analysis"];
+    };
     const double lnz      = sparse->nnz_factor();
     const double fl       = sparse->flops();
     const auto  &sparsity = matrix.get_sparsity_pattern();
@@ -291,6 +313,7 @@ namespace knee_contact
             if (!fits(direct_bytes))
               reason += "; the direct paths' " + megabytes(direct_bytes) +
                         " exceed the " + megabytes(available) + " available";
+            keep_choice_figures();
             sparse.reset();
             return iterative(reason);
           }
@@ -311,6 +334,7 @@ namespace knee_contact
     if (!fits(direct_needed) && fits(iterative_bytes) &&
         (requested != SolverPath::condensed || !fits(sparse_bytes)))
       {
+        keep_choice_figures();
         sparse.reset();
         return iterative("the " + solver_path_name(path) +
                          " path needs about " + megabytes(direct_needed) +
@@ -336,11 +360,7 @@ namespace knee_contact
     if (path == SolverPath::condensed)
       try
         {
-          // The ordering and analysis made for the choice belong to this
-          // path's cost too (the sparse path reports them itself).
-          auto sparse_figures          = sparse->statistics();
-          figures["choice_ordering"]   = sparse_figures["ordering"];
-          figures["choice_analysis"]   = sparse_figures["analysis"];
+          keep_choice_figures();
           const std::vector<int> order = sparse->ordering();
           sparse.reset();
           auto system = std::make_unique<CondensedContactSystem>(matrix,

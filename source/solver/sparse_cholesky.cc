@@ -412,6 +412,8 @@ namespace knee_contact
     {
       if (common.status == CHOLMOD_OUT_OF_MEMORY)
         throw std::bad_alloc();
+      if (common.status == CHOLMOD_TOO_LARGE)
+        throw FactorTooLarge();
       if (common.status < CHOLMOD_OK)
         throw std::runtime_error(std::string("CHOLMOD failed to ") + what +
                                  " (status " + std::to_string(common.status) +

@@ -9,6 +9,7 @@
 #include <cholmod.h>
 
 #include <cstddef>
+#include <stdexcept>
 #include <vector>
 
 namespace knee_contact
@@ -95,6 +96,20 @@ namespace knee_contact
     std::vector<int>
     fill_reducing_ordering(const CsrMatrix                            &a,
                            const std::vector<types::global_dof_index> &last);
+
+    /**
+     * A factor past CHOLMOD's 32-bit indices (more than 2^31 - 1 entries,
+     * about 20 GB of values: a 3D mesh of about 1e6 dofs), found by
+     * SparseCholesky::analyse().
+     */
+    class FactorTooLarge : public std::runtime_error
+    {
+    public:
+      FactorTooLarge()
+        : std::runtime_error("the sparse factor would have more than 2^31 "
+                             "entries (CHOLMOD's 32-bit indices)")
+      {}
+    };
 
     /**
      * CHOLMOD's supernodal LL^T of a symmetric positive definite matrix in
