@@ -1,6 +1,8 @@
 #include <knee_contact/physics/elements.h>
 #include <knee_contact/postprocess/recovery.h>
 
+#include <deal.II/base/work_stream.h>
+
 #include <deal.II/fe/fe_values.h>
 
 #include <algorithm>
@@ -199,6 +201,44 @@ namespace knee_contact
 
 
 
+  namespace
+  {
+    // recovered_error_products()' per-thread buffers (WorkStream copies
+    // them; FEValues is not copyable).
+    template <int dim>
+    struct ProductScratch
+    {
+      ProductScratch(const DoFHandler<dim> &dof_handler)
+        : fe_values(elements::mapping(dof_handler),
+                    dof_handler.get_fe(),
+                    elements::cell_quadrature(dof_handler, 2),
+                    update_values | update_gradients | update_JxW_values)
+      {}
+
+      ProductScratch(const ProductScratch &other)
+        : fe_values(other.fe_values.get_mapping(),
+                    other.fe_values.get_fe(),
+                    other.fe_values.get_quadrature(),
+                    other.fe_values.get_update_flags())
+      {}
+
+      FEValues<dim>                                     fe_values;
+      std::vector<types::global_dof_index>              cell_dofs;
+      std::vector<SymmetricTensor<2, dim>>              shape_strains;
+      std::vector<SymmetricTensor<2, dim>>              strains_u, vertex_u;
+      std::vector<std::vector<SymmetricTensor<2, dim>>> strains_z, vertex_z;
+    };
+
+    struct ProductCopy
+    {
+      unsigned int        cell          = 0;
+      double              eta_u_squared = 0;
+      std::vector<double> products;
+    };
+  } // namespace
+
+
+
   template <int dim>
   std::vector<RecoveredProduct>
   recovered_error_products(const DoFHandler<dim>             &dof_handler,
@@ -211,91 +251,102 @@ namespace knee_contact
     const FiniteElement<dim> &fe         = dof_handler.get_fe();
     const unsigned int        n_vertices = fe.reference_cell().n_vertices();
     const FEValuesExtractors::Vector displacement(0);
-    const unsigned int               n_z = influences.size();
+    const unsigned int               n_z         = influences.size();
+    const unsigned int               n_cell_dofs = fe.n_dofs_per_cell();
 
-    FEValues<dim>      fe_values(elements::mapping(dof_handler),
-                            fe,
-                            elements::cell_quadrature(dof_handler, 2),
-                            update_values | update_gradients |
-                              update_JxW_values);
-    const unsigned int n_q = fe_values.n_quadrature_points;
-    std::vector<SymmetricTensor<2, dim>> strains_u(n_q), vertex_u(n_vertices);
-    std::vector<std::vector<SymmetricTensor<2, dim>>> strains_z(
-      n_z, std::vector<SymmetricTensor<2, dim>>(n_q)),
-      vertex_z(n_z, std::vector<SymmetricTensor<2, dim>>(n_vertices));
-    std::vector<double>           products(n_z);
     std::vector<RecoveredProduct> result(n_z);
     double                        eta_u_squared = 0;
     if (with_indicators)
       for (auto &r : result)
         r.indicators.reinit(dof_handler.get_triangulation().n_active_cells());
-    const unsigned int                   n_cell_dofs = fe.n_dofs_per_cell();
-    std::vector<types::global_dof_index> cell_dofs(n_cell_dofs);
-    std::vector<SymmetricTensor<2, dim>> shape_strains(n_cell_dofs * n_q);
-    // The discrete strains of a solution at the points, from the shape
-    // functions' strains computed once per cell.
-    const auto strains_of = [&](const Vector<double>                 &x,
-                                std::vector<SymmetricTensor<2, dim>> &e) {
-      std::fill(e.begin(), e.end(), SymmetricTensor<2, dim>());
-      for (unsigned int j = 0; j < n_cell_dofs; ++j)
-        {
-          const double value = x(cell_dofs[j]);
-          for (unsigned int q = 0; q < n_q; ++q)
-            e[q] += value * shape_strains[j * n_q + q];
-        }
-    };
-    for (const auto &cell : dof_handler.active_cell_iterators())
-      {
+
+    // Cell by cell in parallel (WorkStream: the sums in the cells' order,
+    // so the result does not depend on the threads).
+    const auto worker =
+      [&](const typename DoFHandler<dim>::active_cell_iterator &cell,
+          ProductScratch<dim>                                  &scratch,
+          ProductCopy                                          &copy) {
+        FEValues<dim>     &fe_values = scratch.fe_values;
+        const unsigned int n_q       = fe_values.n_quadrature_points;
+        scratch.cell_dofs.resize(n_cell_dofs);
+        scratch.shape_strains.resize(n_cell_dofs * n_q);
+        scratch.strains_u.resize(n_q);
+        scratch.vertex_u.resize(n_vertices);
+        scratch.strains_z.resize(n_z);
+        scratch.vertex_z.resize(n_z);
         fe_values.reinit(cell);
-        cell->get_dof_indices(cell_dofs);
+        cell->get_dof_indices(scratch.cell_dofs);
         for (unsigned int j = 0; j < n_cell_dofs; ++j)
           for (unsigned int q = 0; q < n_q; ++q)
-            shape_strains[j * n_q + q] =
+            scratch.shape_strains[j * n_q + q] =
               fe_values[displacement].symmetric_gradient(j, q);
-        strains_of(u, strains_u);
+        // The discrete strains of a solution at the points, from the shape
+        // functions' strains computed once per cell.
+        const auto strains_of = [&](const Vector<double>                 &x,
+                                    std::vector<SymmetricTensor<2, dim>> &e) {
+          e.assign(n_q, SymmetricTensor<2, dim>());
+          for (unsigned int j = 0; j < n_cell_dofs; ++j)
+            {
+              const double value = x(scratch.cell_dofs[j]);
+              for (unsigned int q = 0; q < n_q; ++q)
+                e[q] += value * scratch.shape_strains[j * n_q + q];
+            }
+        };
+        strains_of(u, scratch.strains_u);
         const types::material_id id = cell->material_id();
         for (unsigned int v = 0; v < n_vertices; ++v)
-          vertex_u[v] = recovered_u(cell->vertex_index(v), id);
+          scratch.vertex_u[v] = recovered_u(cell->vertex_index(v), id);
         for (unsigned int i = 0; i < n_z; ++i)
           {
-            strains_of(*influences[i].z, strains_z[i]);
+            strains_of(*influences[i].z, scratch.strains_z[i]);
+            scratch.vertex_z[i].resize(n_vertices);
             for (unsigned int v = 0; v < n_vertices; ++v)
-              vertex_z[i][v] =
+              scratch.vertex_z[i][v] =
                 (*influences[i].recovered)(cell->vertex_index(v), id);
           }
         const Material<dim> &material = materials[id];
-        std::fill(products.begin(), products.end(), 0.);
+        copy.cell                     = cell->active_cell_index();
+        copy.eta_u_squared            = 0;
+        copy.products.assign(n_z, 0.);
         for (unsigned int q = 0; q < n_q; ++q)
           {
             // The recovered strains interpolated with the scalar linear
             // shape function of each vertex (component 0 of the vector
             // element), minus the discrete ones.
-            SymmetricTensor<2, dim> error_u = -strains_u[q];
+            SymmetricTensor<2, dim> error_u = -scratch.strains_u[q];
             for (unsigned int v = 0; v < n_vertices; ++v)
               error_u +=
                 fe_values.shape_value(fe.component_to_system_index(0, v), q) *
-                vertex_u[v];
+                scratch.vertex_u[v];
             const SymmetricTensor<2, dim> stress_u = material.stress(error_u);
-            eta_u_squared += error_u * stress_u * fe_values.JxW(q);
+            copy.eta_u_squared += error_u * stress_u * fe_values.JxW(q);
             for (unsigned int i = 0; i < n_z; ++i)
               {
-                SymmetricTensor<2, dim> error_z = -strains_z[i][q];
+                SymmetricTensor<2, dim> error_z = -scratch.strains_z[i][q];
                 for (unsigned int v = 0; v < n_vertices; ++v)
                   error_z +=
                     fe_values.shape_value(fe.component_to_system_index(0, v),
                                           q) *
-                    vertex_z[i][v];
-                products[i] += error_z * stress_u * fe_values.JxW(q);
+                    scratch.vertex_z[i][v];
+                copy.products[i] += error_z * stress_u * fe_values.JxW(q);
               }
           }
-        for (unsigned int i = 0; i < n_z; ++i)
-          {
-            result[i].product += products[i];
-            if (with_indicators)
-              result[i].indicators(cell->active_cell_index()) =
-                std::abs(products[i]);
-          }
-      }
+      };
+    const auto copier = [&](const ProductCopy &copy) {
+      eta_u_squared += copy.eta_u_squared;
+      for (unsigned int i = 0; i < n_z; ++i)
+        {
+          result[i].product += copy.products[i];
+          if (with_indicators)
+            result[i].indicators(copy.cell) = std::abs(copy.products[i]);
+        }
+    };
+    WorkStream::run(dof_handler.begin_active(),
+                    dof_handler.end(),
+                    worker,
+                    copier,
+                    ProductScratch<dim>(dof_handler),
+                    ProductCopy());
     for (auto &r : result)
       r.eta_u_squared = eta_u_squared;
     return result;
