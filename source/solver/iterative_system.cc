@@ -383,7 +383,12 @@ namespace knee_contact
     // dofs), smoothed aggregation saved 5 % of the CG iterations but took
     // 2.3 times the hierarchy's memory (770 against 330 MB at 2.3e5 dofs)
     // and 20 % more time; Gauss-Seidel smoothing 25 % fewer iterations at
-    // twice the time.
+    // twice the time. In 2D (prm/hertz.prm, 7e3 to 4.3e5 dofs, measured
+    // 2026-11-27) smoothed aggregation kept a fresh solve's CG iterations
+    // nearly bounded (21, 26, 27, 34 against 33, 55, 59, 101), but its
+    // hierarchy served later active sets worse (at most 255 against 128
+    // iterations per solve) and the contact solve took 23 against 16.9 s at
+    // 4.3e5 dofs, with twice the hierarchy's memory.
     Teuchos::ParameterList list;
     ML_Epetra::SetDefaults("SA", list);
     list.set("ML output", 0);

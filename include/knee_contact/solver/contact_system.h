@@ -385,12 +385,13 @@ namespace knee_contact
    * other): each iteration's system, C with the Gamma_u/Gamma_o lines and
    * the active rows condensed (each active row eliminates its dof, the
    * master entries carried by an AffineConstraints), is solved by CG,
-   * preconditioned by Trilinos ML's smoothed aggregation AMG with the rigid
-   * motions as near null space. The operator is applied as T^T C T on the
-   * stiffness matrix (no copy of it per active set); the AMG hierarchy is
-   * built on the condensed matrix of one active set and kept while the
-   * extra CG iterations it costs on later sets stay below the price of a
-   * new hierarchy; each solve starts from the previous solution and stops
+   * preconditioned by Trilinos ML's aggregation AMG (plain aggregation:
+   * see build_amg()) with the rigid motions as near null space. The operator is
+   * applied as T^T C T on the stiffness matrix (no copy of it per active set);
+   * the AMG hierarchy is built on the condensed matrix of one active set and
+   * kept while the extra CG iterations it costs on later sets stay below the
+   * price of a new hierarchy (never rebuilt for the set it was built for); each
+   * solve starts from the previous solution and stops
    * at the accuracy the loop asks for. Memory grows linearly with the dofs:
    * the condensed matrix in Trilinos' format, the hierarchy (about 0.8 of
    * it with plain aggregation) and a few vectors.
