@@ -167,26 +167,29 @@ namespace knee_contact
       const unsigned int        n_vertices = triangulation.n_vertices();
       const unsigned int        n_cells    = triangulation.n_active_cells();
       std::vector<unsigned int> start(n_vertices + 1, 0);
-      // Each cell's vertices from first_corner[c] on (cells of all kinds).
+      // Each cell's vertices from first_corner[c] on (cells of all kinds),
+      // read once: the accessors' cost dominated the check.
       std::vector<unsigned int> first_corner(n_cells + 1, 0);
       for (const auto &cell : triangulation.active_cell_iterators())
-        {
-          first_corner[cell->active_cell_index() + 1] = cell->n_vertices();
-          for (const auto k : cell->vertex_indices())
-            ++start[cell->vertex_index(k) + 1];
-        }
-      std::partial_sum(start.begin(), start.end(), start.begin());
+        first_corner[cell->active_cell_index() + 1] = cell->n_vertices();
       std::partial_sum(first_corner.begin(),
                        first_corner.end(),
                        first_corner.begin());
+      std::vector<unsigned int> corner_vertex(first_corner.back());
+      for (const auto &cell : triangulation.active_cell_iterators())
+        for (const auto k : cell->vertex_indices())
+          {
+            const unsigned int v = cell->vertex_index(k);
+            corner_vertex[first_corner[cell->active_cell_index()] + k] = v;
+            ++start[v + 1];
+          }
+      std::partial_sum(start.begin(), start.end(), start.begin());
       // The slot of each (cell, corner) among the cells at its vertex.
       std::vector<unsigned int> slot_of_corner(first_corner.back());
       {
         std::vector<unsigned int> next(start.begin(), start.end() - 1);
-        for (const auto &cell : triangulation.active_cell_iterators())
-          for (const auto k : cell->vertex_indices())
-            slot_of_corner[first_corner[cell->active_cell_index()] + k] =
-              next[cell->vertex_index(k)]++;
+        for (unsigned int c = 0; c < first_corner.back(); ++c)
+          slot_of_corner[c] = next[corner_vertex[c]]++;
       }
       std::vector<unsigned int> parent(start.back());
       std::iota(parent.begin(), parent.end(), 0);
@@ -195,33 +198,43 @@ namespace knee_contact
           i = parent[i] = parent[parent[i]];
         return i;
       };
+      // All active cells on the finest level (a mesh as read or globally
+      // refined): a neighbour's level index is its active index.
+      const unsigned int finest = triangulation.n_levels() - 1;
+      const bool         one_level =
+        triangulation.n_cells(finest) == triangulation.n_active_cells();
       for (const auto &cell : triangulation.active_cell_iterators())
-        for (const auto f : cell->face_indices())
-          {
-            if (cell->at_boundary(f))
-              continue;
-            const auto neighbour = cell->neighbor(f);
-            if (neighbour->active_cell_index() < cell->active_cell_index())
-              continue;
-            const ReferenceCell kind  = cell->reference_cell();
-            const unsigned int  first = first_corner[cell->active_cell_index()];
-            const unsigned int  first_there =
-              first_corner[neighbour->active_cell_index()];
-            for (unsigned int k = 0;
-                 k < kind.face_reference_cell(f).n_vertices();
-                 ++k)
-              {
-                const unsigned int corner = kind.face_to_cell_vertices(f, k, 1);
-                const unsigned int vertex = cell->vertex_index(corner);
-                for (const auto j : neighbour->vertex_indices())
-                  if (neighbour->vertex_index(j) == vertex)
-                    {
-                      const unsigned int here =
-                        find(slot_of_corner[first + corner]);
-                      parent[here] = find(slot_of_corner[first_there + j]);
-                    }
-              }
-          }
+        {
+          const unsigned int  c    = cell->active_cell_index();
+          const ReferenceCell kind = cell->reference_cell();
+          for (const auto f : cell->face_indices())
+            {
+              // -1: no neighbour (the boundary).
+              const int index = cell->neighbor_index(f);
+              if (index < 0)
+                continue;
+              const unsigned int n = one_level
+                                       ? unsigned(index)
+                                       : cell->neighbor(f)->active_cell_index();
+              if (n < c)
+                continue;
+              for (unsigned int k = 0;
+                   k < kind.face_reference_cell(f).n_vertices();
+                   ++k)
+                {
+                  const unsigned int corner =
+                    first_corner[c] + kind.face_to_cell_vertices(f, k, 1);
+                  for (unsigned int j = first_corner[n];
+                       j < first_corner[n + 1];
+                       ++j)
+                    if (corner_vertex[j] == corner_vertex[corner])
+                      {
+                        const unsigned int here = find(slot_of_corner[corner]);
+                        parent[here]            = find(slot_of_corner[j]);
+                      }
+                }
+            }
+        }
       for (unsigned int v = 0; v < n_vertices; ++v)
         {
           if (start[v + 1] - start[v] < 2)
