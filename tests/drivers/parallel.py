@@ -8,7 +8,8 @@
    case too) to 1e-8; the displacement of every vertex (solution.vtu) to
    1e-8 of max |u|; every contact CSV column to 1e-8 of its largest value,
    and its flags (active, stick or slip, the discretisation) equal. The error
-   bars (influence solves stopped at 1e-3) to 1e-2 of the largest bar.
+   bars (influence solves stopped at a hundredth of their start residual)
+   to 1e-2 of the largest bar.
    The distributed iterative path (Contact/Solver = iterative: CG and AMG
    over the ranks, to 1e-12 of the load; with 3D friction its Newton
    springs) and the direct paths (whole on each rank) both; measured: at most 1.1e-11 (the 3D knee at 2.3e5 dofs,
