@@ -15,6 +15,7 @@
 #include <cmath>
 #include <iomanip>
 #include <numeric>
+#include <set>
 #include <sstream>
 
 namespace knee_contact
@@ -91,32 +92,43 @@ namespace knee_contact
                                  (dim == 2 ? "(x, y) = " : "(x, y, z) = ") +
                                  at(p) + where));
       };
+      // A function written as numbers is the same everywhere: checked on
+      // the first cell it applies to (evaluating it at every vertex and
+      // Gauss point took 4.2 s on a mesh of 2.0e6 tetrahedra).
+      std::set<const Function<dim> *> constants_checked;
+      const auto to_check = [&](const Function<dim> &f, const bool constant) {
+        return !constant || constants_checked.insert(&f).second;
+      };
       for (const auto &cell : triangulation.active_cell_iterators())
         {
           const Material<dim> &material = materials[cell->material_id()];
           const auto          &force    = *material.body_force;
-          const std::string    parameter =
-            "Materials (material '" + material.name + "')/Body force";
-          for (const auto v : cell->vertex_indices())
-            check(force, cell->vertex(v), parameter, "");
-          // The Gauss points, mapped as the assembly maps them.
-          const ReferenceCell kind = cell->reference_cell();
-          const auto         &mapping =
+          const ReferenceCell  kind     = cell->reference_cell();
+          const auto          &mapping =
             kind.template get_default_linear_mapping<dim, dim>();
-          // (The rule is kept in a named variable: a range-for over a
-          // member of a temporary would read freed stack memory.)
-          const Quadrature<dim> cell_points =
-            kind.template get_gauss_type_quadrature<dim>(2);
-          for (const auto &xi : cell_points.get_points())
-            check(force,
-                  mapping.transform_unit_to_real_cell(cell, xi),
-                  parameter,
-                  "");
+          if (to_check(force, material.body_force_is_constant))
+            {
+              const std::string parameter =
+                "Materials (material '" + material.name + "')/Body force";
+              for (const auto v : cell->vertex_indices())
+                check(force, cell->vertex(v), parameter, "");
+              // The Gauss points, mapped as the assembly maps them. (The
+              // rule is kept in a named variable: a range-for over a
+              // member of a temporary would read freed stack memory.)
+              const Quadrature<dim> cell_points =
+                kind.template get_gauss_type_quadrature<dim>(2);
+              for (const auto &xi : cell_points.get_points())
+                check(force,
+                      mapping.transform_unit_to_real_cell(cell, xi),
+                      parameter,
+                      "");
+            }
           for (const auto f : cell->face_indices())
             if (cell->face(f)->at_boundary())
               for (const auto &condition : conditions.conditions())
                 if (condition.function &&
-                    condition.ids.count(cell->face(f)->boundary_id()) != 0)
+                    condition.ids.count(cell->face(f)->boundary_id()) != 0 &&
+                    to_check(*condition.function, condition.constant))
                   {
                     const std::string where =
                       " on boundary id " +

@@ -334,7 +334,8 @@ namespace knee_contact
                                  : std::string("Mesh: the scene's mesh")) +
                      (tetrahedra ? " (tetrahedra: as hexahedra of twice its "
                                    "vertices)"
-                                 : ""));
+                                 : ""),
+                   tetrahedra);
     triangulation.refine_global(n_refine);
     if (n_refine > 0)
       check_cells(triangulation);
@@ -477,23 +478,33 @@ namespace knee_contact
 
   // The members that read files and make rectangles are in mesh_files.cc.
   double
-  estimated_run_bytes(const unsigned int dim, const double n_cells)
+  estimated_run_bytes(const unsigned int dim,
+                      const double       n_cells,
+                      const bool         tetrahedra)
   {
     // About 8 kB per cell in 2D for matrix, factorisation and vectors
     // (measured: 1.8 GB for 236 544 cells with contact); in 3D the factor
     // fills in more: measured 1.3 GB peak for 32 768 hexahedra (1.1e5
     // DoFs), 35 kB per cell, and 21 kB at 4 096 (about cells^(1/4));
     // estimated with cells^(1/3) above 3.3e4 to stay on the safe side.
-    // Where a factor does not fit, the iterative path (CG with AMG) solves
-    // in memory linear in the cells: measured 1.16 GB peak for the 3D
-    // knee's 4.5e5 tetrahedra (7.8e4 vertices, 2.3e5 dofs; 1.6e5 cells as
-    // hexahedra), 6 to 8 kB per hexahedron beyond the libraries, estimated
-    // at 12 kB (hexahedra have more matrix entries per vertex than
-    // tetrahedra) and 50 MB for the results.
     if (dim == 2)
       return 8e3 * n_cells;
-    return std::min(3.5e4 * std::max(1., std::cbrt(n_cells / 3.3e4)) * n_cells,
-                    5e7 + 1.2e4 * n_cells);
+    const double direct =
+      3.5e4 * std::max(1., std::cbrt(n_cells / 3.3e4)) * n_cells;
+    // Where a factor does not fit, the iterative path (CG with AMG) solves
+    // in memory linear in the dofs: 40 bytes per matrix entry (the matrix,
+    // Trilinos' condensed copy and the hierarchy) and 2.5 kB per dof (mesh,
+    // DoF handler, vectors, error bars, output; measured on the 3D knee's
+    // tetrahedra, 45 entries a row: 4.1 kB per dof at 1.0e6 dofs, 3.9 at
+    // 1.7e6), beside 50 MB for the results (the libraries are loaded and
+    // counted as used already). Hexahedra have about one dof triple per
+    // cell and 81 entries a row; tetrahedra (as hexahedra of twice their
+    // vertices) 1.5 dofs per such cell and 45 entries. (The former 12 kB
+    // per such cell, 8 kB per tetrahedral dof, refused the knee at 4.2e6
+    // dofs: 33 GB.)
+    const double dofs    = (tetrahedra ? 1.5 : 3.) * n_cells;
+    const double entries = tetrahedra ? 45 : 81;
+    return std::min(direct, 5e7 + dofs * (2.5e3 + 40 * entries));
   }
 
 
@@ -501,11 +512,12 @@ namespace knee_contact
   void
   check_run_fits(const unsigned int dim,
                  const double       n_cells,
-                 const std::string &what)
+                 const std::string &what,
+                 const bool         tetrahedra)
   {
     std::string  limit;
     const double available = memory::available(limit);
-    const double needed    = estimated_run_bytes(dim, n_cells);
+    const double needed    = estimated_run_bytes(dim, n_cells, tetrahedra);
     const auto   gigabytes = [](const double bytes) {
       std::ostringstream out;
       out << std::setprecision(3) << bytes / 1e9 << " GB";

@@ -106,12 +106,17 @@ namespace knee_contact
                     ExcMessage(condition.name +
                                "/Components: no component selected"));
         if (condition.type != BoundaryType::sliding)
-          condition.function = input::parse_expression<dim>(
-            entry.value,
-            condition.type == BoundaryType::pressure ? 1 : dim,
-            condition.name + "/Value",
-            "",
-            condition.type != BoundaryType::displacement);
+          {
+            condition.function = input::parse_expression<dim>(
+              entry.value,
+              condition.type == BoundaryType::pressure ? 1 : dim,
+              condition.name + "/Value",
+              "",
+              condition.type != BoundaryType::displacement);
+            condition.constant = true;
+            for (const auto &part : input::split(entry.value, ';'))
+              condition.constant &= input::number(part).has_value();
+          }
         list.push_back(std::move(condition));
       }
   }

@@ -275,12 +275,15 @@ namespace knee_contact
   check_cells(const Triangulation<dim> &triangulation);
 
   /**
-   * The memory a run on @p n_cells cells in @p dim dimensions needs with
-   * the direct solver paths [bytes]: matrix, factorisation and vectors,
-   * measured (see mesh.cc).
+   * The memory a run on @p n_cells cells in @p dim dimensions needs on the
+   * cheaper of its solver paths [bytes]: matrix, factorisation or AMG
+   * hierarchy and vectors, measured (see mesh.cc). In 3D, @p tetrahedra:
+   * the cells are hexahedra of twice the vertices of a tetrahedral mesh.
    */
   double
-  estimated_run_bytes(unsigned int dim, double n_cells);
+  estimated_run_bytes(unsigned int dim,
+                      double       n_cells,
+                      bool         tetrahedra = false);
 
   /**
    * Refuse, before anything of the size is allocated, a mesh of @p n_cells
@@ -290,7 +293,10 @@ namespace knee_contact
    * parameter that asks for the size.
    */
   void
-  check_run_fits(unsigned int dim, double n_cells, const std::string &what);
+  check_run_fits(unsigned int       dim,
+                 double             n_cells,
+                 const std::string &what,
+                 bool               tetrahedra = false);
 } // namespace knee_contact
 
 #endif

@@ -40,6 +40,8 @@ namespace knee_contact
     std::set<types::boundary_id>         ids;
     ComponentMask                        mask;
     std::unique_ptr<FunctionParser<dim>> function;
+    /** The function is written as numbers: the same everywhere. */
+    bool constant = false;
   };
 
 

@@ -41,6 +41,8 @@ namespace knee_contact
     std::unique_ptr<FunctionParser<dim>> body_force;
     /** The body force is written as zeros: nothing to integrate. */
     bool body_force_is_zero = false;
+    /** The body force is written as numbers: the same everywhere. */
+    bool body_force_is_constant = false;
 
     /**
      * Stress from strain (in 2D the in-plane components).
