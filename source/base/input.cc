@@ -91,6 +91,17 @@ namespace knee_contact
 
 
 
+    bool
+    numbers_only(const std::string &expression)
+    {
+      for (const auto &part : split(expression, ';'))
+        if (!number(part))
+          return false;
+      return true;
+    }
+
+
+
     double
     to_double(const std::string &text, const std::string &parameter)
     {

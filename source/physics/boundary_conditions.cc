@@ -113,9 +113,7 @@ namespace knee_contact
               condition.name + "/Value",
               "",
               condition.type != BoundaryType::displacement);
-            condition.constant = true;
-            for (const auto &part : input::split(entry.value, ';'))
-              condition.constant &= input::number(part).has_value();
+            condition.constant = input::numbers_only(entry.value);
           }
         list.push_back(std::move(condition));
       }

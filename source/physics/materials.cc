@@ -239,13 +239,10 @@ namespace knee_contact
                                        "",
                                        true);
         // Written as zeros ("0; 0", the 2D default): assembly skips it.
-        material.body_force_is_zero     = true;
-        material.body_force_is_constant = true;
+        material.body_force_is_zero = true;
         for (const auto &part : input::split(entry.body_force, ';'))
-          {
-            material.body_force_is_zero &= input::number(part) == 0.;
-            material.body_force_is_constant &= input::number(part).has_value();
-          }
+          material.body_force_is_zero &= input::number(part) == 0.;
+        material.body_force_is_constant = input::numbers_only(entry.body_force);
       }
 
     // A contrast beyond 1e12 leaves fewer than 4 correct digits in the

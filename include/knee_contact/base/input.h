@@ -121,6 +121,13 @@ namespace knee_contact
     number(const std::string &text);
 
     /**
+     * Whether every ';'-separated part of @p expression is a number: a
+     * function written this way is the same everywhere (and at every time).
+     */
+    bool
+    numbers_only(const std::string &expression);
+
+    /**
      * A finite double from @p text (white space around it allowed), or an
      * error naming @p parameter.
      */
