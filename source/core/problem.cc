@@ -316,13 +316,24 @@ namespace knee_contact
     if (contact_pairs.frictional())
       friction_rows = contact_pairs.solver_rows();
 
+    // In 3D the friction loop's Newton step sets springs on the two
+    // tangential rows of a slipping pair (solve_with_friction()).
+    std::vector<std::vector<unsigned int>> spring_rows;
+    if (dim == 3 && contact_pairs.frictional())
+      {
+        const FrictionRowLayout at{
+          static_cast<unsigned int>(contact_pairs.size()), dim};
+        for (unsigned int p = 0; p < at.n_pairs; ++p)
+          spring_rows.push_back({at.tangential(0, p), at.tangential(1, p)});
+      }
     DynamicSparsityPattern mesh_pattern(dof_handler.n_dofs());
     DoFTools::make_sparsity_pattern(dof_handler, mesh_pattern);
     ActiveSetSolver::make_sparsity_pattern(mesh_pattern,
                                            constraints,
                                            rows_for_solver(),
                                            sparsity_pattern,
-                                           contact_pairs.frictional());
+                                           contact_pairs.frictional(),
+                                           spring_rows);
     system_matrix.reinit(sparsity_pattern);
   }
 

@@ -213,11 +213,12 @@ namespace knee_contact
 
   void
   ActiveSetSolver::make_sparsity_pattern(
-    const DynamicSparsityPattern    &mesh_pattern,
-    const AffineConstraints<double> &base,
-    const std::vector<ContactRow>   &pairs,
-    SparsityPattern                 &sparsity_pattern,
-    const bool                       cycles_allowed)
+    const DynamicSparsityPattern                 &mesh_pattern,
+    const AffineConstraints<double>              &base,
+    const std::vector<ContactRow>                &pairs,
+    SparsityPattern                              &sparsity_pattern,
+    const bool                                    cycles_allowed,
+    const std::vector<std::vector<unsigned int>> &spring_rows)
   {
     // One sparsity pattern serves every active set. Condensing a set of
     // lines couples each dof i with the dofs its line refers to after
@@ -290,6 +291,28 @@ namespace knee_contact
       closure(entry.first);
 
     DynamicSparsityPattern dsp(mesh_pattern.n_rows());
+    const auto             expanded = [&](const types::global_dof_index i) {
+      const auto e = expansion.find(i);
+      return e == expansion.end() ? std::vector<types::global_dof_index>{i}
+                                              : e->second;
+    };
+    // A spring k w w^T couples every dof of its rows' reduced rows with
+    // every other, and each of them expands as a line of the mesh's
+    // pattern does.
+    for (const auto &group : spring_rows)
+      {
+        std::set<types::global_dof_index> dofs;
+        for (const unsigned int r : group)
+          for (const auto &entry : pairs[r].reduced_row)
+            {
+              const auto e = expanded(entry.first);
+              dofs.insert(e.begin(), e.end());
+            }
+        const std::vector<types::global_dof_index> sorted(dofs.begin(),
+                                                          dofs.end());
+        for (const auto a : sorted)
+          dsp.add_entries(a, sorted.begin(), sorted.end(), true);
+      }
     for (types::global_dof_index i = 0; i < mesh_pattern.n_rows(); ++i)
       {
         const auto ei = expansion.find(i);
@@ -315,17 +338,20 @@ namespace knee_contact
 
 
   void
-  ActiveSetSolver::excess_and_multipliers(const SparseMatrix<double> &matrix,
-                                          const Vector<double>       &rhs,
-                                          const Vector<double>       &x,
-                                          const AffineConstraints<double> &base,
-                                          const std::vector<ContactRow> &pairs,
-                                          const std::vector<bool>       &active,
-                                          std::vector<double>           &excess,
-                                          std::vector<double>           &lambda)
+  ActiveSetSolver::excess_and_multipliers(
+    const SparseMatrix<double>      &matrix,
+    const Vector<double>            &rhs,
+    const Vector<double>            &x,
+    const AffineConstraints<double> &base,
+    const std::vector<ContactRow>   &pairs,
+    const std::vector<bool>         &active,
+    std::vector<double>             &excess,
+    std::vector<double>             &lambda,
+    const std::vector<SpringTerm>   &springs)
   {
     Vector<double> residual(rhs.size());
     matrix.residual(residual, x, rhs);
+    springs::add_forces(springs, x, residual);
     lambda = multipliers(residual, base, pairs, active);
     excess.resize(pairs.size());
     for (unsigned int p = 0; p < pairs.size(); ++p)

@@ -3,6 +3,7 @@
 // reference the other paths are tested against (tests/unit/solver_paths.cc).
 #include <knee_contact/solver/active_set.h>
 #include <knee_contact/solver/contact_system.h>
+#include <knee_contact/solver/springs.h>
 
 #include <deal.II/lac/sparse_direct.h>
 
@@ -37,8 +38,15 @@ namespace knee_contact
     AffineConstraints<double> constraints;
     ActiveSetSolver::make_constraints(base, pairs, active, constraints);
     Assert(rhs != nullptr, ExcMessage("set_rhs() was not called"));
+    // The springs' matrix k w w^T and load k g_w w; the condensation
+    // takes the constraints' inhomogeneities through both.
+    const auto terms = springs::on_dofs(springs, pairs);
     system_matrix.copy_from(matrix);
+    springs::add_to_matrix(terms, system_matrix);
     system_rhs = *rhs;
+    for (const auto &term : terms)
+      for (const auto &[i, a] : term.w)
+        system_rhs(i) += term.stiffness * term.g_w * a;
     constraints.condense(system_matrix, system_rhs);
     SparseDirectUMFPACK direct;
     direct.initialize(system_matrix);
@@ -46,7 +54,15 @@ namespace knee_contact
     constraints.distribute(x);
 
     ActiveSetSolver::excess_and_multipliers(
-      matrix, *rhs, x, base, pairs, active, excess, lambda);
+      matrix, *rhs, x, base, pairs, active, excess, lambda, terms);
+  }
+
+
+
+  void
+  FullContactSystem::set_springs(const std::vector<Spring> &new_springs)
+  {
+    springs = new_springs;
   }
 
 

@@ -2,6 +2,7 @@
 #include <knee_contact/solver/active_set.h>
 #include <knee_contact/solver/contact_system.h>
 #include <knee_contact/solver/sparse_cholesky.h>
+#include <knee_contact/solver/springs.h>
 
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/timer.h>
@@ -37,26 +38,6 @@ namespace knee_contact
       return stats.VmRSS / 1024.;
     }
 
-    /**
-     * A spring of ContactSystem::Spring on the dofs: energy
-     * 1/2 k (w . x - g_w)^2, w = sum_r c_r a'_r over the rows' reduced rows
-     * (the dofs Gamma_u and Gamma_o leave free), g_w the same sum of their
-     * reduced gaps: the terms the condensed path adds to its Schur
-     * complement, here added to the operator (k w w^T), to the right hand
-     * side and to the residual of the multipliers.
-     */
-    struct SpringTerm
-    {
-      std::vector<std::pair<types::global_dof_index, double>> w;
-      double                                                  g_w       = 0;
-      double                                                  stiffness = 0;
-
-      double
-      dot(const Vector<double> &x) const
-      {
-        return sparse_dot(w, x);
-      }
-    };
 
     /**
      * The condensed operator of one active set, T^T C T on the free dofs
@@ -286,7 +267,7 @@ namespace knee_contact
     unsigned int                     n_modes = 0;
 
     /** The springs of the following solves (set_springs()). */
-    std::vector<iterative::SpringTerm> springs;
+    std::vector<SpringTerm> springs;
     /** The rows of this rank (all of them on one). */
     IndexSet                       owned;
     AffineConstraints<double>      constraints;
@@ -648,13 +629,7 @@ namespace knee_contact
         // T^T sum k w (g_w - w . g), g the constraints' inhomogeneities.
         Vector<double> g(d.matrix.m()), pull(d.matrix.m());
         d.constraints.distribute(g);
-        for (const auto &spring : d.springs)
-          {
-            const double force =
-              spring.stiffness * (spring.g_w - spring.dot(g));
-            for (const auto &[i, a] : spring.w)
-              pull(i) += force * a;
-          }
+        springs::add_forces(d.springs, g, pull);
         sparse_cholesky::condense_homogeneous(d.constraints, pull);
         for (const auto &line : d.constraints.get_lines())
           pull(line.index) = 0;
@@ -737,27 +712,15 @@ namespace knee_contact
     // side exist: the figure its estimate is checked against.
     if (d.totals.n_solves == 1)
       d.measured_MB = iterative::resident_MB() - d.resident_at_start;
-    if (d.springs.empty())
-      ActiveSetSolver::excess_and_multipliers(
-        d.matrix, *d.rhs, d.x, d.base, d.pairs, active, excess, lambda);
-    else
-      {
-        // The residual less the springs' forces k (w x - g_w) w.
-        Vector<double> residual(d.matrix.m());
-        d.matrix.residual(residual, d.x, *d.rhs);
-        for (const auto &spring : d.springs)
-          {
-            const double force =
-              spring.stiffness * (spring.dot(d.x) - spring.g_w);
-            for (const auto &[i, a] : spring.w)
-              residual(i) -= force * a;
-          }
-        lambda =
-          ActiveSetSolver::multipliers(residual, d.base, d.pairs, active);
-        excess.resize(d.pairs.size());
-        for (unsigned int p = 0; p < d.pairs.size(); ++p)
-          excess[p] = d.pairs[p].jump(d.x) - d.pairs[p].gap;
-      }
+    ActiveSetSolver::excess_and_multipliers(d.matrix,
+                                            *d.rhs,
+                                            d.x,
+                                            d.base,
+                                            d.pairs,
+                                            active,
+                                            excess,
+                                            lambda,
+                                            d.springs);
   }
 
 
@@ -765,22 +728,7 @@ namespace knee_contact
   void
   IterativeContactSystem::set_springs(const std::vector<Spring> &springs)
   {
-    Implementation &d = *implementation;
-    d.springs.clear();
-    for (const auto &spring : springs)
-      {
-        iterative::SpringTerm term;
-        term.stiffness = spring.stiffness;
-        std::map<types::global_dof_index, double> w;
-        for (const auto &[r, c] : spring.rows)
-          {
-            for (const auto &[i, a] : d.pairs[r].reduced_row)
-              w[i] += c * a;
-            term.g_w += c * d.pairs[r].reduced_gap;
-          }
-        term.w.assign(w.begin(), w.end());
-        d.springs.push_back(std::move(term));
-      }
+    implementation->springs = springs::on_dofs(springs, implementation->pairs);
   }
 
 

@@ -157,11 +157,13 @@ namespace knee_contact
         }
     const bool friction = n_measured > 0;
     // 3D friction (FrictionRowLayout: two tangential rows per pair, a third
-    // of all rows): only the condensed path takes the semismooth Newton
-    // step (ContactSystem::takes_springs()), and with it its per-iteration
-    // system holds the tangential rows too. Measured on the 3D knee
-    // (34 059 dofs, mu = 0.04, four load cases): 11 to 18 iterations there,
-    // no convergence in 50 on the iterative path.
+    // of all rows): the loop takes the semismooth Newton step, whose
+    // springs (ContactSystem::set_springs()) the condensed path's
+    // per-iteration system takes with the tangential rows, the sparse path
+    // into a new factorisation at each iteration, and the iterative path
+    // into CG's operator, where AMG on C does not see them: measured on
+    // the 3D knee (34 059 dofs, mu = 0.04, four load cases) 11 to 18
+    // Newton iterations, but up to 4 682 CG iterations a solve.
     const bool   newton = friction && 3 * n_measured == pairs.size();
     const double k = contact.size(), P = n_rows + (newton ? n_measured : 0);
 
@@ -236,7 +238,12 @@ namespace knee_contact
     // With friction about one per two iterations (knee, 1.35e5 dofs, mu =
     // 0.04: 6 factorisations and 7 bordered updates, 20 update solves, in
     // 13 iterations).
-    const double sparse_flops = (friction     ? 0.5 * iterations
+    // With the Newton step's springs, which change at every iteration,
+    // about 0.7 per iteration: a set that stays is solved by CG on the
+    // last factor (3D knee, 1.25e5 dofs, mu = 0.04, four load cases: 37
+    // factorisations and 15 such solves in 52 iterations).
+    const double sparse_flops = (newton       ? 0.7 * iterations
+                                 : friction   ? 0.5 * iterations
                                  : warm_start ? 1.3
                                               : 0.65 * iterations) *
                                 fl;
@@ -279,12 +286,9 @@ namespace knee_contact
     std::string reason;
     if (requested == SolverPath::automatic)
       {
-        path = condensed_flops <= sparse_flops || newton ? SolverPath::condensed
-                                                         : SolverPath::sparse;
-        reason = std::string(newton ? "3D friction: the condensed path takes "
-                                      "the Newton step; "
-                                    : "") +
-                 "estimated " + gigaflops(condensed_flops) +
+        path   = condensed_flops <= sparse_flops ? SolverPath::condensed
+                                                 : SolverPath::sparse;
+        reason = "estimated " + gigaflops(condensed_flops) +
                  " condensed (k = " + std::to_string(int(k)) +
                  " contact unknowns, P = " + std::to_string(int(P)) +
                  " rows) against " + gigaflops(sparse_flops) +
@@ -304,11 +308,15 @@ namespace knee_contact
         seconds << std::setprecision(2) << "; about " << direct_seconds
                 << " s against " << iterative_seconds << " s iterative (AMG, "
                 << int(krylov_iterations) << " CG iterations expected)";
+        // The iterative path's time model does not hold with the Newton
+        // springs (CG's count grows by an order of magnitude): a direct
+        // path that fits serves 3D friction.
+        if (newton)
+          seconds << ", a direct path for 3D friction where one fits";
         reason += seconds.str();
         if (fits(iterative_bytes) &&
             (!fits(direct_bytes) ||
-             (iterative_seconds < direct_seconds &&
-              !(newton && path == SolverPath::condensed))))
+             (iterative_seconds < direct_seconds && !newton)))
           {
             if (!fits(direct_bytes))
               reason += "; the direct paths' " + megabytes(direct_bytes) +

@@ -1,10 +1,13 @@
 #include <knee_contact/solver/active_set.h>
 #include <knee_contact/solver/contact_system.h>
 #include <knee_contact/solver/sparse_cholesky.h>
+#include <knee_contact/solver/springs.h>
 
 #include <deal.II/base/timer.h>
 
 #include <deal.II/lac/lapack_templates.h>
+#include <deal.II/lac/solver_cg.h>
+#include <deal.II/lac/solver_control.h>
 
 #include <algorithm>
 #include <cmath>
@@ -53,14 +56,26 @@ namespace knee_contact
       return result;
     }
 
-    /** C v for a sparse v (C symmetric: its rows serve as columns). */
+    /**
+     * (C + sum k w w^T) v for a sparse v (C symmetric: its rows serve as
+     * columns).
+     */
     SparseVector
-    multiply(const SparseMatrix<double> &c, const SparseVector &v)
+    multiply(const SparseMatrix<double>    &c,
+             const std::vector<SpringTerm> &springs,
+             const SparseVector            &v)
     {
       std::map<types::global_dof_index, double> sum;
       for (const auto &[j, value] : v)
         for (auto it = c.begin(j); it != c.end(j); ++it)
           sum[it->column()] += it->value() * value;
+      for (const auto &spring : springs)
+        {
+          const double stretch = spring.stiffness * dot(spring.w, v);
+          if (stretch != 0)
+            for (const auto &[i, a] : spring.w)
+              sum[i] += stretch * a;
+        }
       return SparseVector(sum.begin(), sum.end());
     }
 
@@ -90,6 +105,29 @@ namespace knee_contact
     AffineConstraints<double> constraints;
     bool                      has_factor = false;
     std::vector<bool>         base_active;
+    /**
+     * The springs of the following solves (set_springs()): the matrix is
+     * K = C + sum k w w^T and the load d + sum k g_w w throughout.
+     */
+    std::vector<SpringTerm> springs;
+    /** The springs in the factor (those of its factorisation). */
+    std::vector<SpringTerm> factor_springs;
+
+    /** K x (C and the springs). */
+    void
+    vmult(Vector<double> &dst, const Vector<double> &x) const
+    {
+      matrix.vmult(dst, x);
+      springs::vmult_add(springs, x, dst);
+    }
+
+    /** d + sum k g_w w - K x = d - C x + sum k (g_w - w x) w. */
+    void
+    residual(Vector<double> &dst, const Vector<double> &x) const
+    {
+      matrix.residual(dst, x, *rhs);
+      springs::add_forces(springs, x, dst);
+    }
 
     /**
      * A correction of the base space for one pair whose state differs
@@ -112,9 +150,10 @@ namespace knee_contact
     Vector<double> x;
 
     double ordering = 0, analysis = 0, factorisation = 0, solves = 0,
-           updates                = 0;
+           updates = 0, stale_factor_time = 0;
+    unsigned int n_stale_factor_solves = 0, stale_factor_iterations = 0;
     unsigned int n_factorisations = 0, n_solves = 0, n_updates = 0,
-                 n_corrections = 0, n_updates_on_factor = 0;
+                 n_corrections = 0, n_updates_on_factor = 0, n_spring_sets = 0;
 
     void
     factorise(const std::vector<bool> &active);
@@ -122,6 +161,15 @@ namespace knee_contact
     /** One solve with the factor: T K0^-1 T^T b (b overwritten). */
     void
     solve_base_homogeneous(Vector<double> &b);
+
+    /**
+     * Solve the factor's system with the springs set now (T^T K T y = b
+     * on the factor's active set), CG preconditioned by the factor of the
+     * springs it was made with, from @p y; false if CG does not reach the
+     * factorisation's accuracy within what a factorisation would cost.
+     */
+    bool
+    solve_with_stale_factor(const Vector<double> &b, Vector<double> &y);
 
     Correction
     make_correction(const unsigned int p);
@@ -141,8 +189,10 @@ namespace knee_contact
     if (!has_factor && n_factorisations == 0)
       condensed.reinit(matrix.get_sparsity_pattern());
     condensed.copy_from(matrix);
+    springs::add_to_matrix(springs, condensed);
     constraints.condense(condensed);
-    has_factor = false;
+    factor_springs = springs;
+    has_factor     = false;
     if (!cholesky.factorise(condensed))
       AssertThrow(false, ExcNotPositiveDefinite());
     has_factor  = true;
@@ -164,6 +214,74 @@ namespace knee_contact
     cholesky.solve(CHOLMOD_A, z);
     std::copy(z.begin(), z.end(), b.begin());
     sparse_cholesky::distribute_homogeneous(constraints, b);
+  }
+
+
+
+  bool
+  SparseContactSystem::Implementation::solve_with_stale_factor(
+    const Vector<double> &b,
+    Vector<double>       &y)
+  {
+    // Why: the semismooth Newton step of 3D friction sets new spring
+    // stiffnesses at every iteration while the active set mostly stays (a
+    // slipping pair is active by its normal row alone). K differs from the
+    // factor's matrix by the change of the springs, sum dk w w^T, so the
+    // factor is a preconditioner that CG needs few iterations with; a
+    // factorisation costs as much as hundreds of its solves in 3D.
+    // (T^T K T y: y spread over the constrained lines, K applied, the
+    // constrained lines folded back; they stay zero, as the factor keeps
+    // them.)
+    struct Operator
+    {
+      const Implementation &d;
+      void
+      vmult(Vector<double> &dst, const Vector<double> &src) const
+      {
+        Vector<double> spread = src;
+        sparse_cholesky::distribute_homogeneous(d.constraints, spread);
+        d.vmult(dst, spread);
+        sparse_cholesky::condense_homogeneous(d.constraints, dst);
+      }
+    };
+    struct Preconditioner
+    {
+      sparse_cholesky::SparseCholesky &cholesky;
+      void
+      vmult(Vector<double> &dst, const Vector<double> &src) const
+      {
+        std::vector<double> z(src.begin(), src.end());
+        cholesky.solve(CHOLMOD_A, z);
+        std::copy(z.begin(), z.end(), dst.begin());
+      }
+    };
+    // A CG iteration costs about one correction's solve (16 nnz(L) flops
+    // at the factorisation's rate, measured: see solve()) and a product
+    // with K; give up when half a factorisation is spent.
+    const double per_iteration =
+      16 * cholesky.nnz_factor() + 2. * matrix.n_nonzero_elements();
+    const unsigned int max_iterations = static_cast<unsigned int>(
+      std::max(5., 0.5 * cholesky.flops() / per_iteration));
+    Timer          clock;
+    SolverControl  control(max_iterations,
+                          1e-12 * std::max(b.l2_norm(), 1e-300),
+                          false,
+                          false);
+    SolverCG<>     cg(control);
+    const Operator operation{*this};
+    bool           converged = true;
+    try
+      {
+        cg.solve(operation, y, b, Preconditioner{cholesky});
+      }
+    catch (const SolverControl::NoConvergence &)
+      {
+        converged = false;
+      }
+    stale_factor_time += clock.wall_time();
+    stale_factor_iterations += control.last_step();
+    n_stale_factor_solves += converged;
+    return converged;
   }
 
 
@@ -192,7 +310,7 @@ namespace knee_contact
         lines.distribute(zero);
         unit -= zero;
         c.v  = sparse(unit);
-        c.cv = multiply(matrix, c.v);
+        c.cv = multiply(matrix, springs, c.v);
         for (const auto &[i, value] : c.cv)
           w(i) = value;
       }
@@ -254,6 +372,20 @@ namespace knee_contact
 
 
   void
+  SparseContactSystem::set_springs(const std::vector<Spring> &springs)
+  {
+    // New stiffnesses or directions are a new matrix: the next solve
+    // starts from the factor of the old one (solve()); new gaps are a new
+    // load only.
+    Implementation &d = *implementation;
+    d.springs         = springs::on_dofs(springs, d.pairs);
+    d.base_solved     = false;
+    ++d.n_spring_sets;
+  }
+
+
+
+  void
   SparseContactSystem::gaps_changed()
   {
     Implementation &d = *implementation;
@@ -304,10 +436,16 @@ namespace knee_contact
     // at most the factor's memory.
     const double correction_flops = 16 * d.cholesky.nnz_factor();
     const double vector_MB        = 8. * d.matrix.m() / 1048576.;
+    // With other springs than the factor's, only the factor's own active
+    // set is solved on it (by CG, solve_with_stale_factor()); the bordered
+    // update needs exact solves.
+    const auto stale = [&]() {
+      return !springs::same_matrix(d.springs, d.factor_springs);
+    };
     if (!d.has_factor || (n_new + 1) * correction_flops > d.cholesky.flops() ||
         (d.corrections.size() + n_new) * vector_MB >
           std::max(d.cholesky.memory_MB(), 8 * vector_MB) ||
-        changed.size() > 500)
+        changed.size() > 500 || (!changed.empty() && stale()))
       {
         d.factorise(active);
         changed.clear();
@@ -317,14 +455,43 @@ namespace knee_contact
     const auto solve_base = [&]() {
       if (d.base_solved)
         return;
-      const auto b = sparse_cholesky::condense(d.matrix, *d.rhs, d.constraints);
-      std::vector<double> z(b.begin(), b.end());
-      d.cholesky.solve(CHOLMOD_A, z);
-      d.x0.reinit(z.size());
-      std::copy(z.begin(), z.end(), d.x0.begin());
+      // T^T (d + sum k g_w w - K g) with g the constraints'
+      // inhomogeneities: the springs' part is their forces at g.
+      Vector<double> load = *d.rhs;
+      if (!d.springs.empty())
+        {
+          Vector<double> g(load.size());
+          d.constraints.distribute(g);
+          springs::add_forces(d.springs, g, load);
+        }
+      const auto b = sparse_cholesky::condense(d.matrix, load, d.constraints);
+      bool       solved = false;
+      if (stale())
+        {
+          // From the last solution's free part.
+          Vector<double> y(b.size());
+          if (d.x0.size() == b.size())
+            {
+              y = d.x0;
+              for (const auto &line : d.constraints.get_lines())
+                y(line.index) = 0;
+            }
+          solved = d.solve_with_stale_factor(b, y);
+          if (solved)
+            d.x0 = y;
+          else
+            d.factorise(active);
+        }
+      if (!solved)
+        {
+          std::vector<double> z(b.begin(), b.end());
+          d.cholesky.solve(CHOLMOD_A, z);
+          d.x0.reinit(z.size());
+          std::copy(z.begin(), z.end(), d.x0.begin());
+        }
       d.constraints.distribute(d.x0);
-      d.residual0.reinit(z.size());
-      d.matrix.residual(d.residual0, d.x0, *d.rhs);
+      d.residual0.reinit(b.size());
+      d.residual(d.residual0, d.x0);
       d.base_solved = true;
       ++d.n_solves;
     };
@@ -388,7 +555,7 @@ namespace knee_contact
                   {
                     dx0 = r;
                     d.solve_base_homogeneous(dx0);
-                    d.matrix.vmult(r, dx0);
+                    d.vmult(r, dx0);
                     r.sadd(-1., 1., residual_of_x);
                   }
                 std::vector<double> z(m);
@@ -418,7 +585,7 @@ namespace knee_contact
                       for (const auto &[dof, value] : c.v)
                         d.x(dof) += z[i] * value;
                   }
-                d.matrix.residual(residual_of_x, d.x, *d.rhs);
+                d.residual(residual_of_x, d.x);
                 r = residual_of_x;
               }
           }
@@ -428,8 +595,15 @@ namespace knee_contact
       }
 
     clock.restart();
-    ActiveSetSolver::excess_and_multipliers(
-      d.matrix, *d.rhs, d.x, d.base, d.pairs, active, excess, lambda);
+    ActiveSetSolver::excess_and_multipliers(d.matrix,
+                                            *d.rhs,
+                                            d.x,
+                                            d.base,
+                                            d.pairs,
+                                            active,
+                                            excess,
+                                            lambda,
+                                            d.springs);
     d.solves += clock.wall_time();
   }
 
@@ -482,6 +656,10 @@ namespace knee_contact
             {"update_time", d.updates},
             {"solve_and_multipliers", d.solves},
             {"factor_memory_MB", d.cholesky.memory_MB()},
-            {"factor_flops", d.cholesky.flops()}};
+            {"factor_flops", d.cholesky.flops()},
+            {"spring_sets", d.n_spring_sets},
+            {"stale_factor_solves", d.n_stale_factor_solves},
+            {"stale_factor_cg_iterations", d.stale_factor_iterations},
+            {"stale_factor_time", d.stale_factor_time}};
   }
 } // namespace knee_contact

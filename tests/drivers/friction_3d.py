@@ -30,10 +30,15 @@
 5. The tilted held case with pictures on: pressure_block.png and
    friction_block.png (the stick/slip map) are written.
 Each held case runs on the automatic path (condensed: the semismooth Newton
-step, 9-10 iterations), on the sparse one (which takes no springs: the
-Anderson-accelerated fixed point on the slip forces, 19-62 iterations; the
-scenes allow 100) and on the iterative one (the Newton springs applied in
-CG with AMG); their energy and max |u| agree to 1e-8.
+step's springs in its dense multiplier system, 9-10 iterations), on the
+sparse one (the springs in each iteration's CHOLMOD factor), on step-41's
+(UMFPACK on the whole condensed system, the springs added before the
+condensation) and on the iterative one (the springs applied in CG with
+AMG); their energy and max |u| agree to 1e-8, and the three direct paths
+take the same number of iterations (the same Newton loop on paths that
+solve each system exactly). The sparse path solves a system whose active
+set is its factor's but whose springs are new by CG on that factor: the
+held cases must take that branch at least once.
 Usage: friction_3d.py KNEE_CONTACT
 """
 import json
@@ -147,6 +152,10 @@ def iterations(summary):
 def main():
     binary = os.path.abspath(sys.argv[1])
     failures = 0
+    # The sparse path's solves on a factor made with other springs (CG on
+    # the last factor where the active set stayed): they must have been
+    # taken, so that the comparison above covers them.
+    stale_solves = 0
     with tempfile.TemporaryDirectory() as folder:
         # 1. mu = 0.
         for name, tolerance, plain, other in mu_zero_runs(
@@ -203,12 +212,13 @@ def main():
                 for pairing in ("node-to-segment", "mortar"):
                     name = "statics_%g_%g_%s" % (angle, ratio, pairing)
                     if ratio < mu:
-                        # The automatic path (condensed: the semismooth
-                        # Newton step), the sparse one (no springs: the
-                        # accelerated fixed point) and the iterative one
-                        # (the Newton springs applied in CG) must agree.
+                        # The automatic path (condensed), the sparse one,
+                        # step-41's and the iterative one, each with the
+                        # Newton step's springs in its own algebra, must
+                        # agree.
                         found = {}
-                        for solver in ("automatic", "sparse", "iterative"):
+                        for solver in ("automatic", "sparse", "step-41",
+                                       "iterative"):
                             summary = run(binary, stack(
                                 load, folder, name + solver, pairing=pairing,
                                 mu=mu, angle=angle, solver=solver), folder,
@@ -239,10 +249,20 @@ def main():
                                 found["sparse"][key]) / abs(
                                 found["sparse"][key])
                             for key in ("energy", "max_displacement")
-                            for other in ("automatic", "iterative"))
-                        print("  the three paths' energy and max |u| differ "
+                            for other in ("automatic", "step-41",
+                                          "iterative"))
+                        print("  the four paths' energy and max |u| differ "
                               "by %.1e (tolerance 1e-8)" % difference)
                         failures += difference > 1e-8
+                        stale_solves += found["sparse"]["solver"][
+                            "stale_factor_solves"]
+                        counts = set(iterations(found[solver])
+                                     for solver in ("automatic", "sparse",
+                                                    "step-41"))
+                        if len(counts) != 1:
+                            print("  the direct paths took different "
+                                  "numbers of iterations: %s" % sorted(counts))
+                            failures += 1
                     # Below the ratio (the level stack at mu = 0.1, the
                     # tilted one at 1.03 mu): refused, naming it.
                     weak = 0.1 if angle == 0 else mu
@@ -262,6 +282,9 @@ def main():
                            "names the ratio" if ok else "WRONG",
                            lines[-1] if lines else ""))
                     failures += not ok
+        print("the sparse path solved %d systems by CG on a factor with "
+              "other springs (must be > 0)" % stale_solves)
+        failures += stale_solves == 0
         # 5. The pictures of a frictional 3D interface: the pressure map
         # and the stick/slip map (scripts/plot_results_3d.py) are written.
         R = rotation(0.7)

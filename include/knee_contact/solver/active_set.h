@@ -4,6 +4,7 @@
 #include <knee_contact/contact/contact_row.h>
 #include <knee_contact/physics/rigid_modes.h>
 #include <knee_contact/solver/contact_system.h>
+#include <knee_contact/solver/springs.h>
 
 #include <deal.II/base/parameter_handler.h>
 
@@ -243,14 +244,18 @@ namespace knee_contact
      * One sparsity pattern for the condensed systems of every active set of
      * @p pairs under @p base (see the comment in the code);
      * @p cycles_allowed with friction, whose rows are not all active
-     * together.
+     * together; @p spring_rows: groups of rows a spring may combine
+     * (ContactSystem::Spring: the tangential rows of a 3D frictional pair),
+     * whose dofs the pattern couples with each other too.
      */
     static void
-    make_sparsity_pattern(const DynamicSparsityPattern    &mesh_pattern,
-                          const AffineConstraints<double> &base,
-                          const std::vector<ContactRow>   &pairs,
-                          SparsityPattern                 &sparsity_pattern,
-                          const bool cycles_allowed = false);
+    make_sparsity_pattern(
+      const DynamicSparsityPattern                 &mesh_pattern,
+      const AffineConstraints<double>              &base,
+      const std::vector<ContactRow>                &pairs,
+      SparsityPattern                              &sparsity_pattern,
+      const bool                                    cycles_allowed = false,
+      const std::vector<std::vector<unsigned int>> &spring_rows    = {});
 
     /**
      * The constraints of @p base plus the active rows of @p pairs, closed.
@@ -274,8 +279,9 @@ namespace knee_contact
 
     /**
      * What a path that solves for the whole x reports (step-41, sparse):
-     * the multipliers from the residual d - C x (multipliers()) and the
-     * excess (A x - g)_p of every pair from its jump.
+     * the multipliers from the residual d - C x (multipliers()), less the
+     * forces of the @p springs set, and the excess (A x - g)_p of every
+     * pair from its jump.
      */
     static void
     excess_and_multipliers(const SparseMatrix<double>      &matrix,
@@ -285,7 +291,8 @@ namespace knee_contact
                            const std::vector<ContactRow>   &pairs,
                            const std::vector<bool>         &active,
                            std::vector<double>             &excess,
-                           std::vector<double>             &lambda);
+                           std::vector<double>             &lambda,
+                           const std::vector<SpringTerm>   &springs = {});
 
     /**
      * max |x_i| over the contact unknowns (every free dof of a row that

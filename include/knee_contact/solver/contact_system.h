@@ -174,6 +174,19 @@ namespace knee_contact
     void
     set_rhs(const Vector<double> &rhs) override;
 
+    /**
+     * Springs are added to the matrix before the condensation (on the
+     * pattern that couples each spring's dofs) and to the load.
+     */
+    bool
+    takes_springs() const override
+    {
+      return true;
+    }
+
+    void
+    set_springs(const std::vector<Spring> &springs) override;
+
     void
     solve(const std::vector<bool> &active,
           std::vector<double>     &excess,
@@ -190,6 +203,7 @@ namespace knee_contact
     const Vector<double>            *rhs = nullptr;
     const AffineConstraints<double> &base;
     const std::vector<ContactRow>   &pairs;
+    std::vector<Spring>              springs;
     SparseMatrix<double>             system_matrix;
     Vector<double>                   system_rhs;
     Vector<double>                   x;
@@ -329,6 +343,21 @@ namespace knee_contact
     solve(const std::vector<bool> &active,
           std::vector<double>     &excess,
           std::vector<double>     &lambda) override;
+
+    /**
+     * Springs enter the factorised matrix (C + sum k w w^T condensed, on
+     * the pattern that couples each spring's dofs), the load and the
+     * multipliers' residual: new stiffnesses or directions cost the next
+     * solve a factorisation, new gaps a new load only.
+     */
+    bool
+    takes_springs() const override
+    {
+      return true;
+    }
+
+    void
+    set_springs(const std::vector<Spring> &springs) override;
 
     /**
      * The factor stays (the gaps enter only the constraints'

@@ -1,0 +1,77 @@
+#ifndef knee_contact_springs_h
+#define knee_contact_springs_h
+
+#include <knee_contact/contact/contact_row.h>
+#include <knee_contact/solver/contact_system.h>
+
+#include <deal.II/lac/sparse_matrix.h>
+#include <deal.II/lac/vector.h>
+
+#include <utility>
+#include <vector>
+
+namespace knee_contact
+{
+  using namespace dealii;
+
+  /**
+   * A spring of ContactSystem::Spring on the dofs: energy
+   * 1/2 k (w . x - g_w)^2, w = sum_r c_r a'_r over the rows' reduced rows
+   * (the dofs Gamma_u and Gamma_o leave free), g_w the same sum of their
+   * reduced gaps. The condensed path adds it to its Schur complement; the
+   * paths that solve for the whole x (step-41, sparse, iterative) add
+   * k w w^T to their matrix or operator, k g_w w to the right hand side,
+   * and its force to the residual their multipliers are read from.
+   */
+  struct SpringTerm
+  {
+    std::vector<std::pair<types::global_dof_index, double>> w;
+    double                                                  g_w       = 0;
+    double                                                  stiffness = 0;
+
+    double
+    dot(const Vector<double> &x) const
+    {
+      return sparse_dot(w, x);
+    }
+  };
+
+  namespace springs
+  {
+    /** The springs @p springs on the rows @p pairs, on the dofs. */
+    std::vector<SpringTerm>
+    on_dofs(const std::vector<ContactSystem::Spring> &springs,
+            const std::vector<ContactRow>            &pairs);
+
+    /**
+     * Whether @p a and @p b are the same springs up to their gaps (the
+     * same matrix k w w^T: a factor of it stays valid).
+     */
+    bool
+    same_matrix(const std::vector<SpringTerm> &a,
+                const std::vector<SpringTerm> &b);
+
+    /**
+     * matrix += sum k w w^T. The pattern must hold every w's dofs coupled
+     * (ActiveSetSolver::make_sparsity_pattern with the springs' row
+     * groups); an entry it lacks is an internal error, not dropped.
+     */
+    void
+    add_to_matrix(const std::vector<SpringTerm> &springs,
+                  SparseMatrix<double>          &matrix);
+
+    /** v += sum k (g_w - w . x) w: the springs' forces at @p x. */
+    void
+    add_forces(const std::vector<SpringTerm> &springs,
+               const Vector<double>          &x,
+               Vector<double>                &v);
+
+    /** v += sum k (w . x) w. */
+    void
+    vmult_add(const std::vector<SpringTerm> &springs,
+              const Vector<double>          &x,
+              Vector<double>                &v);
+  } // namespace springs
+} // namespace knee_contact
+
+#endif
