@@ -152,14 +152,16 @@ def zoom(axes, s, t, zone):
 
 
 def friction_map(folder, interface, rows, s, t, e1, e2, normal, zone):
-    """The same view of a frictional interface: each slave vertex coloured
-    by its status (stick, slip, open) and the slipping ones' slip in this
-    case drawn in the plane of the view (its part along the normal is not
-    seen)."""
+    """The same view of a frictional interface: on the left each slave
+    vertex coloured by its status (stick, slip, open) and the slipping
+    ones' slip in this case drawn in the plane of the view (its part along
+    the normal is not seen); on the right the accumulated slip along the
+    load path (the micromotion) at each vertex."""
     status = np.array([r["status"] for r in rows])
     slip = np.array([[float(r[k]) for k in ("slip_x", "slip_y", "slip_z")]
                      for r in rows])
-    figure, axes = plt.subplots(figsize=(7, 6))
+    accumulated = np.array([float(r["accumulated_slip"]) for r in rows])
+    figure, (axes, right) = plt.subplots(1, 2, figsize=(13, 6))
     for kind, colour, size in (("open", "0.75", 4), ("stick", "tab:blue", 14),
                                ("slip", "tab:orange", 14)):
         chosen = status == kind
@@ -179,6 +181,15 @@ def friction_map(folder, interface, rows, s, t, e1, e2, normal, zone):
     axes.set_title("contact '%s': stick and slip seen along the mean slave "
                    "normal\n(%.2f, %.2f, %.2f)" % (interface, *normal),
                    fontsize=10)
+    shown = right.scatter(s * 1e3, t * 1e3, s=14, c=accumulated * 1e6,
+                          cmap="viridis")
+    figure.colorbar(shown, ax=right, label="accumulated slip [µm]")
+    zoom(right, s, t, zone)
+    right.set_xlabel("e1 [mm]")
+    right.set_ylabel("e2 [mm]")
+    right.set_title("accumulated slip along the load path (micromotion),\n"
+                    "largest %.3g µm" % (accumulated.max() * 1e6),
+                    fontsize=10)
     save(figure, os.path.join(folder, "friction_" +
                               csv_name(interface)[len("contact_"):-4] +
                               ".png"))

@@ -464,10 +464,25 @@ namespace knee_contact
                       {bound * direction[0] + ct * s[0],
                        bound * direction[1] + ct * s[1]}};
                     stick = magnitude(v) <= bound;
-                    // With the Newton step the slip's own direction, else
-                    // v's (a damped fixed point).
+                    // With the Newton step the direction of
+                    // bound d + c_s s, c_s the springs' constant
+                    // (100 E_max h): the slip's own where it is large,
+                    // the force's where the pair barely slips (at the
+                    // stick/slip boundary the slip's own direction is that
+                    // of a slip of 1e-10 of the displacements and turned
+                    // the force back and forth: a small step of the 3D
+                    // tray's load path, prm/tibial_tray_3d_friction.prm,
+                    // took 50 iterations without converging, now 11);
+                    // without it v's (a damped fixed point).
                     if (!stick)
-                      direction = newton && s_norm > 0 ? unit(s) : unit(v);
+                      {
+                        const double c_s = c * rows[p].spacing(dim);
+                        direction        = newton && s_norm > 0
+                                             ? unit(TangentialVector{
+                                          {bound * direction[0] + c_s * s[0],
+                                                  bound * direction[1] + c_s * s[1]}})
+                                             : unit(v);
+                      }
                   }
                 else if (!stick && s_norm > 0)
                   direction = unit(s);
