@@ -29,6 +29,14 @@
    naming the ratio 1.2 x 0.3 = 0.36.
 5. The tilted held case with pictures on: pressure_block.png and
    friction_block.png (the stick/slip map) are written.
+6. A load path with a small step: prm/tibial_tray_3d_friction.prm (the
+   tray and insert held on the bone by friction alone, five cases, the
+   last 1.2 % below the fourth): every case converges in at most 20
+   iterations, and the interface force on the tray balances the load on
+   the insert to 1e-8 relative (statics). Its last case took 50
+   iterations without converging while a slipping pair's next direction
+   was its slip's own (1e-10 of the displacements at the stick/slip
+   boundary).
 Each held case runs on the automatic path (condensed: the semismooth Newton
 step's springs in its dense multiplier system, 9-10 iterations), on the
 sparse one (the springs in each iteration's CHOLMOD factor), on step-41's
@@ -298,6 +306,32 @@ def main():
             path = os.path.join(folder, "pictures", picture)
             ok = os.path.exists(path) and os.path.getsize(path) > 0
             print("picture %s: %s" % (picture, "written" if ok else "MISSING"))
+            failures += not ok
+        # 6. The tray's load path.
+        prm = os.path.join(HERE, "..", "..", "prm")
+        with open(os.path.join(prm, "tibial_tray_3d_friction.prm")) as f:
+            text = f.read()
+        text = text.replace("set File           = tibial_tray_3d.geo",
+                            "set File           = " + os.path.join(
+                                prm, "tibial_tray_3d.geo"))
+        text += ("subsection Output\n  set Folder = %s\n  set Pictures = "
+                 "false\nend\n" % os.path.join(folder, "tray"))
+        run_scene(binary, text, folder, "tray")
+        for case in range(5):
+            with open(os.path.join(folder, "tray", "case_%03d" % case,
+                                   "summary.json")) as f:
+                summary = json.load(f)
+            tray = summary["contact_interfaces"]["tray"]
+            load = summary["applied_load"]
+            total = [load[d] + tray["force_on_slave"][d] +
+                     tray["tangential_force_on_slave"][d] for d in range(3)]
+            error = max(abs(x) for x in total) / max(abs(x) for x in load)
+            ok = (summary["converged"] and
+                  summary["active_set_iterations"] <= 20 and error <= 1e-8)
+            print("tray path, case %d: %s in %d iterations (at most 20), "
+                  "interface force + load relative %.1e (tolerance 1e-8)" %
+                  (case, "converged" if summary["converged"] else
+                   "NOT converged", summary["active_set_iterations"], error))
             failures += not ok
     print("PASS" if failures == 0 else "FAIL: %d checks" % failures)
     return 1 if failures else 0
