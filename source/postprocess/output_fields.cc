@@ -456,7 +456,9 @@ namespace knee_contact
                              : "tangential_traction_x,tangential_traction_y,"
                                "tangential_traction_z,slip_x,slip_y,slip_z,")
                 << "accumulated_slip,status,";
-          out << "discretisation\n" << std::setprecision(10);
+          // The row's weight l_p [m, m^2 in 3D] (pressure times weight is
+          // the pair's force), so that a CSV integrates on its own.
+          out << "weight,discretisation\n" << std::setprecision(10);
           double s = 0;
           for (unsigned int k = 0; k < order.size(); ++k)
             {
@@ -496,7 +498,8 @@ namespace knee_contact
                   out << contact.accumulated_slip[p] << ','
                       << status_name(contact.status[p]) << ',';
                 }
-              out << pairing_name(results.interfaces[i].pairing) << '\n';
+              out << row.length << ','
+                  << pairing_name(results.interfaces[i].pairing) << '\n';
             }
         });
       }
