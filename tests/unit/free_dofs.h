@@ -10,6 +10,7 @@
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/vector.h>
 
+#include <iostream>
 #include <vector>
 
 struct FreeDofs
@@ -51,5 +52,56 @@ struct FreeDofs
     C0.Tvmult(b, fmKg);
   }
 };
+
+/**
+ * The rows @p rows (a_r x <= g_r) in the free dofs: A z <= c with
+ * A = a_r C0 and c = g_r - a_r g0.
+ */
+template <typename Row>
+void
+rows_in_free_dofs(const std::vector<const Row *> &rows,
+                  const FreeDofs                 &reduced,
+                  dealii::FullMatrix<double>     &A,
+                  dealii::Vector<double>         &c)
+{
+  A.reinit(rows.size(), reduced.n_free);
+  c.reinit(rows.size());
+  for (unsigned int r = 0; r < rows.size(); ++r)
+    {
+      c(r) = rows[r]->gap;
+      for (const auto &[dof, a] : rows[r]->row)
+        {
+          c(r) -= a * reduced.g0(dof);
+          for (unsigned int j = 0; j < reduced.n_free; ++j)
+            A(r, j) += a * reduced.C0(dof, j);
+        }
+    }
+}
+
+/**
+ * The friction enumeration tests' verdict: the loop's statuses are the
+ * enumerated state's, x and the multipliers agree to 1e-10 relative, the
+ * run succeeded and every status (bits of @p seen: open, stick, slip)
+ * occurs; printed, and returned.
+ */
+inline bool
+friction_verdict(const bool         same_states,
+                 const double       x_error,
+                 const double       lambda_error,
+                 const int          status,
+                 const unsigned int seen)
+{
+  const bool pass = same_states && x_error <= 1e-10 && lambda_error <= 1e-10 &&
+                    status == 0 && seen == 7;
+  std::cout << "check statuses equal, relative differences of x and of "
+               "lambda_n, lambda_t to the enumerated solution <= 1e-10, "
+               "every state present: "
+            << (pass ? "PASS" : "FAIL") << std::endl;
+  if (!pass)
+    std::cout << "  x " << x_error << ", lambda " << lambda_error
+              << ", states present (bits open, stick, slip) " << seen
+              << std::endl;
+  return pass;
+}
 
 #endif
