@@ -44,9 +44,8 @@ namespace knee_contact
     system_matrix.copy_from(matrix);
     springs::add_to_matrix(terms, system_matrix);
     system_rhs = *rhs;
-    for (const auto &term : terms)
-      for (const auto &[i, a] : term.w)
-        system_rhs(i) += term.stiffness * term.g_w * a;
+    // (The springs' forces at x = 0: sum k g_w w.)
+    springs::add_forces(terms, Vector<double>(matrix.m()), system_rhs);
     constraints.condense(system_matrix, system_rhs);
     SparseDirectUMFPACK direct;
     direct.initialize(system_matrix);

@@ -621,20 +621,10 @@ namespace knee_contact
     Assert(d.rhs != nullptr, ExcMessage("set_rhs() was not called"));
     Timer clock;
     ActiveSetSolver::make_constraints(d.base, d.pairs, active, d.constraints);
-    // The condensed right hand side T^T (d - C g), g the inhomogeneities.
-    Vector<double> b =
-      sparse_cholesky::condense(d.matrix, *d.rhs, d.constraints);
-    if (!d.springs.empty())
-      {
-        // T^T sum k w (g_w - w . g), g the constraints' inhomogeneities.
-        Vector<double> g(d.matrix.m()), pull(d.matrix.m());
-        d.constraints.distribute(g);
-        springs::add_forces(d.springs, g, pull);
-        sparse_cholesky::condense_homogeneous(d.constraints, pull);
-        for (const auto &line : d.constraints.get_lines())
-          pull(line.index) = 0;
-        b += pull;
-      }
+    // The condensed right hand side T^T (d + sum k g_w w - K g), g the
+    // inhomogeneities.
+    const Vector<double> b =
+      springs::condensed_load(d.springs, d.matrix, *d.rhs, d.constraints);
     d.condensation += clock.wall_time();
 
     // A hierarchy is kept while the CG iterations it costs beyond its rate

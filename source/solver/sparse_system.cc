@@ -455,17 +455,9 @@ namespace knee_contact
     const auto solve_base = [&]() {
       if (d.base_solved)
         return;
-      // T^T (d + sum k g_w w - K g) with g the constraints'
-      // inhomogeneities: the springs' part is their forces at g.
-      Vector<double> load = *d.rhs;
-      if (!d.springs.empty())
-        {
-          Vector<double> g(load.size());
-          d.constraints.distribute(g);
-          springs::add_forces(d.springs, g, load);
-        }
-      const auto b = sparse_cholesky::condense(d.matrix, load, d.constraints);
-      bool       solved = false;
+      const auto b =
+        springs::condensed_load(d.springs, d.matrix, *d.rhs, d.constraints);
+      bool solved = false;
       if (stale())
         {
           // From the last solution's free part.

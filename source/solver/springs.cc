@@ -1,3 +1,4 @@
+#include <knee_contact/solver/sparse_cholesky.h>
 #include <knee_contact/solver/springs.h>
 
 #include <deal.II/base/exceptions.h>
@@ -82,6 +83,22 @@ namespace knee_contact
           for (const auto &[i, a] : spring.w)
             v(i) += force * a;
         }
+    }
+
+
+
+    Vector<double>
+    condensed_load(const std::vector<SpringTerm>   &springs,
+                   const SparseMatrix<double>      &matrix,
+                   const Vector<double>            &rhs,
+                   const AffineConstraints<double> &constraints)
+    {
+      if (springs.empty())
+        return sparse_cholesky::condense(matrix, rhs, constraints);
+      Vector<double> g(rhs.size()), load = rhs;
+      constraints.distribute(g);
+      add_forces(springs, g, load);
+      return sparse_cholesky::condense(matrix, load, constraints);
     }
 
 

@@ -4,6 +4,7 @@
 #include <knee_contact/contact/contact_row.h>
 #include <knee_contact/solver/contact_system.h>
 
+#include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/vector.h>
 
@@ -65,6 +66,17 @@ namespace knee_contact
     add_forces(const std::vector<SpringTerm> &springs,
                const Vector<double>          &x,
                Vector<double>                &v);
+
+    /**
+     * The condensed load of K x = d + sum k g_w w under @p constraints:
+     * T^T (d + sum k g_w w - K g), g the constraints' inhomogeneities
+     * (sparse_cholesky::condense() with the springs' forces at g).
+     */
+    Vector<double>
+    condensed_load(const std::vector<SpringTerm>   &springs,
+                   const SparseMatrix<double>      &matrix,
+                   const Vector<double>            &rhs,
+                   const AffineConstraints<double> &constraints);
 
     /** v += sum k (w . x) w. */
     void
