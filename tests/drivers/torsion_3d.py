@@ -35,8 +35,6 @@ and a moment of 1.1 times the full-slip bound is refused in one line
 integrals) is not checked here.
 Usage: torsion_3d.py KNEE_CONTACT
 """
-import csv
-import json
 import math
 import os
 import sys
@@ -44,11 +42,12 @@ import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
+from cattaneo_mindlin import (E, E_STAR, MU, NU, R, check,  # noqa: E402
+                              read_case)
 from friction import run_scene  # noqa: E402
 
 GEO = os.path.normpath(os.path.join(HERE, "..", "meshes", "cattaneo_3d.geo"))
-E, NU, MU, R, D, H = 1.0, 0.3, 0.3, 1.0, 0.005, 0.01
-E_STAR = E / (2 * (1 - NU * NU))
+D, H = 0.005, 0.01
 FRACTIONS = (0.5, 0.9, 0.97)
 
 SCENE = """
@@ -115,18 +114,9 @@ def scene(folder, name, upper="0; 0; 0", lower="0; 0; 0", held_z=False,
 
 
 def read(folder):
-    with open(os.path.join(folder, "summary.json")) as f:
-        summary = json.load(f)
-    with open(os.path.join(folder, "contact_cm.csv")) as f:
-        rows = [r for r in csv.DictReader(f) if r["active"] == "1"]
-    return summary, rows
-
-
-def check(name, value, tolerance, failures):
-    ok = value <= tolerance
-    print("%-62s %.3e <= %.1e: %s" % (name, value, tolerance,
-                                       "PASS" if ok else "FAIL"))
-    return failures + (0 if ok else 1)
+    """read_case() with the contact CSV's active rows only."""
+    summary, rows = read_case(folder)
+    return summary, [r for r in rows if r["active"] == "1"]
 
 
 def main():
