@@ -3,6 +3,7 @@
 
 Usage: parallel_scaling.py KNEE_CONTACT SCENE.prm [--ranks 1 2 4]
            [--repeat 3] [--solver iterative]
+           [--model [--small SMALLER_SCENE.prm]]
 
 N = 1 runs as one process (no mpirun); N > 1 under mpirun (oversubscribed
 where N exceeds the cores: the communication terms show, the speed-up
@@ -14,6 +15,13 @@ rank 0 (every rank holds about the same) and the largest relative
 difference of the contact forces and peak pressures from the one-process
 run. Times are the median over --repeat runs; the ratios are of medians
 measured in this one invocation (the machine is noisy).
+
+--model (ranks 1 and 2 needed) fits scaling_model.py's constants to the
+N = 1 and N = 2 runs, prints its prediction beside each measured N (N = 4
+on this 2-core machine checks its oversubscription and communication
+terms), and extrapolates to 1e7 and 1e8 DoFs on 16-256 ranks. --small
+names the same model at a smaller size, run on one rank for the CG
+iterations' growth with the DoFs (else they are taken constant).
 """
 import argparse
 import json
@@ -23,6 +31,9 @@ import statistics
 import subprocess
 import sys
 import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import scaling_model  # noqa: E402
 
 
 def run(binary, scene_text, folder, ranks):
@@ -56,6 +67,28 @@ def contact_numbers(summary):
     return values
 
 
+def scene_text(scene, solver):
+    """The scene's text for a run: its files found from anywhere, @p solver
+    (if given) as Contact/Solver, the output into @FOLDER@, no pictures."""
+    scene = os.path.abspath(scene)
+    text = open(scene).read()
+    # Relative paths of the scene (meshes) from its folder.
+    here = os.path.dirname(scene)
+    text = re.sub(r"(set File\s*=\s*)(\S+)",
+                  lambda m: m.group(1) + os.path.normpath(
+                      os.path.join(here, m.group(2))), text)
+    if solver:
+        text = re.sub(r"\n\s*set Solver\s*=.*", "", text)
+        text = text.replace("subsection Contact", "subsection Contact\n"
+                            "  set Solver = %s" % solver, 1)
+    text = re.sub(r"\n\s*set (Folder|Terminal|Write files|Pictures)\s*=.*",
+                  "", text)
+    if "subsection Output" not in text:
+        text += "subsection Output\nend\n"
+    return text.replace("subsection Output", "subsection Output\n"
+                        "  set Folder = @FOLDER@\n  set Pictures = false", 1)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("binary")
@@ -65,25 +98,14 @@ def main():
     parser.add_argument("--solver", default=None,
                         help="Contact/Solver for every run (default: the "
                         "scene's)")
+    parser.add_argument("--model", action="store_true",
+                        help="fit and check the scaling model")
+    parser.add_argument("--small", default=None,
+                        help="the scene at a smaller size (--model)")
     args = parser.parse_args()
     binary = os.path.abspath(args.binary)
     scene = os.path.abspath(args.scene)
-    text = open(scene).read()
-    # Relative paths of the scene (meshes) from its folder.
-    here = os.path.dirname(scene)
-    text = re.sub(r"(set File\s*=\s*)(\S+)",
-                  lambda m: m.group(1) + os.path.normpath(
-                      os.path.join(here, m.group(2))), text)
-    if args.solver:
-        text = re.sub(r"\n\s*set Solver\s*=.*", "", text)
-        text = text.replace("subsection Contact", "subsection Contact\n"
-                            "  set Solver = %s" % args.solver, 1)
-    text = re.sub(r"\n\s*set (Folder|Terminal|Write files|Pictures)\s*=.*",
-                  "", text)
-    if "subsection Output" not in text:
-        text += "subsection Output\nend\n"
-    text = text.replace("subsection Output", "subsection Output\n"
-                        "  set Folder = @FOLDER@\n  set Pictures = false", 1)
+    text = scene_text(scene, args.solver)
     stem = os.path.splitext(os.path.basename(scene))[0]
 
     rows, reference = [], None
@@ -115,6 +137,9 @@ def main():
             "measured": median(
                 lambda s: s["solver"].get("iterative_memory_MB", 0)),
             "peak": median(lambda s: s["solver"].get("peak_memory_MB", 0)),
+            "output": median(lambda s: s["wall_time"].get("output", 0) +
+                             s["wall_time"].get("pictures", 0)),
+            "pairs": summaries[0].get("n_contact_pairs", 0),
             "difference": difference})
 
     print("| ranks | DoFs | path | whole run [s] | solve [s] | Krylov [s] "
@@ -131,6 +156,64 @@ def main():
                   base["run"] / row["run"],
                   base["solve"] / max(row["solve"], 1e-9), row["estimate"],
                   row["measured"], row["peak"], row["difference"]))
+    if args.model:
+        small = None
+        if args.small:
+            folder = os.path.abspath(
+                os.path.join("output", "scaling", stem + "_small"))
+            summary, _ = run(binary, scene_text(args.small, args.solver),
+                             folder, 1)
+            small = {"dofs": summary["n_dofs"],
+                     "cg": summary["solver"].get("krylov_iterations", 0)}
+        print_model(rows, small)
+
+
+def print_model(rows, small):
+    """The model fitted to N = 1, 2 beside every measured N, and its
+    extrapolation (scaling_model.py)."""
+    by_ranks = {row["ranks"]: row for row in rows}
+    if 1 not in by_ranks or 2 not in by_ranks:
+        sys.exit("--model needs runs on 1 and 2 ranks")
+    for row in rows:
+        row["path_measured"] = row["measured"]
+    model = scaling_model.fit(by_ranks[1], by_ranks[2])
+    cores = os.cpu_count()
+    print("\nModel (scripts/scaling_model.py) fitted to N = 1, 2 on %d cores:"
+          % cores)
+    print(", ".join("%s %.4g" % (k, v) for k, v in model.items()))
+    print("\n| ranks | run measured [s] | model [s] | model with measured "
+          "CG it. [s] | error | R meas. / model [s] | K meas. / model [s] "
+          "| memory per rank meas. / model [MB] |")
+    print("|" + "---|" * 8)
+    for row in rows:
+        assumed = scaling_model.predict(model, row["ranks"], cores)
+        with_cg = scaling_model.predict(model, row["ranks"], cores,
+                                        iterations=row["cg"])
+        print("| %d | %.1f | %.1f | %.1f | %+.0f %% | %.1f / %.1f "
+              "| %.1f / %.1f | %.0f / %.0f |" % (
+                  row["ranks"], row["run"], assumed["run"], with_cg["run"],
+                  100 * (assumed["run"] / row["run"] - 1),
+                  scaling_model.replicated(row), assumed["R"], row["krylov"],
+                  assumed["K"], row["peak"], assumed["memory"]))
+    alpha = 0.0
+    if small:
+        alpha = scaling_model.iteration_exponent(small, by_ranks[1])
+        print("\nCG iterations %d at %d DoFs, %d at %d: alpha %.2f" % (
+            small["cg"], small["dofs"], by_ranks[1]["cg"],
+            by_ranks[1]["dofs"], alpha))
+    print("\nExtrapolated (network assumed: %s; one rank per core):" %
+          scaling_model.ASSUMED_NETWORK)
+    print("\n| DoFs | ranks | CG it. | this stage: run [s] / memory per "
+          "rank [GB] | distributed stage: run [s] / memory per rank [GB] |")
+    print("|---|---|---|---|---|")
+    for dofs in (1e7, 1e8):
+        for ranks in (16, 64, 256):
+            e = scaling_model.extrapolate(model, alpha, dofs, ranks,
+                                          2 * by_ranks[1]["pairs"])
+            print("| %.0e | %d | %.0f | %.0f / %.1f | %.0f / %.2f |" % (
+                dofs, ranks, e["cg"], e["stage"]["run"],
+                e["stage"]["memory"] / 1024, e["distributed"]["run"],
+                e["distributed"]["memory"] / 1024))
 
 
 if __name__ == "__main__":

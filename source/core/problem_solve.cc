@@ -70,12 +70,7 @@ namespace knee_contact
             {
               refinement.refine(strategy,
                                 triangulation,
-                                dof_handler,
-                                displacement,
-                                materials,
-                                contact_interfaces,
-                                contact_pairs,
-                                contact_solution,
+                                access(),
                                 goal_indicator());
               check_cells(triangulation);
             }
@@ -379,9 +374,8 @@ namespace knee_contact
           }
         if (new_matrix)
           {
-            solver_figures.clear();
             contact_system.reset();
-            contact_system =
+            SolverChoice choice =
               make_contact_system(active_set_solver.linear_solver(),
                                   system_matrix,
                                   constraints,
@@ -389,9 +383,10 @@ namespace knee_contact
                                   rigid_modes,
                                   active_set_solver.krylov_settings(),
                                   !guess.empty(),
-                                  output_writer.test_mode() ? quiet : loop_log,
-                                  solver_name,
-                                  solver_figures);
+                                  output_writer.test_mode() ? quiet : loop_log);
+            contact_system = std::move(choice.system);
+            solver_name    = std::move(choice.name);
+            solver_figures = std::move(choice.figures);
           }
         if (!contact_pairs.frictional())
           {
@@ -540,16 +535,25 @@ namespace knee_contact
   Results<dim>
   ContactProblem<dim>::current_results() const
   {
-    return compute_results(dof_handler,
-                           body_of_cell,
-                           system_matrix,
-                           system_rhs,
-                           displacement,
-                           materials,
-                           boundary_conditions,
-                           contact_interfaces,
-                           contact_pairs,
-                           contact_solution);
+    return compute_results(access());
+  }
+
+
+
+  template <int dim>
+  ProblemAccess<dim>
+  ContactProblem<dim>::access() const
+  {
+    return {dof_handler,
+            body_of_cell,
+            system_matrix,
+            system_rhs,
+            displacement,
+            materials,
+            boundary_conditions,
+            contact_interfaces,
+            contact_pairs,
+            contact_solution};
   }
 
 

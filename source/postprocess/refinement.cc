@@ -98,16 +98,12 @@ namespace knee_contact
 
   template <int dim>
   void
-  Refinement::refine(const Strategy           strategy,
-                     Triangulation<dim>      &triangulation,
-                     const DoFHandler<dim>   &dof_handler,
-                     const Vector<double>    &solution,
-                     const Materials<dim>    &materials,
-                     const ContactInterfaces &interfaces,
-                     const ContactPairs<dim> &pairs,
-                     const ContactSolution   &contact,
-                     const Vector<float>     *goal) const
+  Refinement::refine(const Strategy            strategy,
+                     Triangulation<dim>       &triangulation,
+                     const ProblemAccess<dim> &state,
+                     const Vector<float>      *goal) const
   {
+    const DoFHandler<dim> &dof_handler = state.dof_handler;
     if (strategy == Strategy::global)
       {
         triangulation.refine_global(1);
@@ -123,11 +119,11 @@ namespace knee_contact
           dof_handler,
           elements::face_quadrature(dof_handler, 2),
           {},
-          solution,
+          state.solution,
           kelly);
         for (const auto &cell : triangulation.active_cell_iterators())
           kelly(cell->active_cell_index()) *=
-            std::sqrt(materials[cell->material_id()].youngs_modulus);
+            std::sqrt(state.materials[cell->material_id()].youngs_modulus);
       }
     GridRefinement::refine_and_coarsen_fixed_fraction(triangulation,
                                                       kelly,
@@ -138,8 +134,9 @@ namespace knee_contact
         // The contact zone: within one slave spacing of an active pair, on
         // either side.
         std::vector<std::pair<Point<dim>, double>> zone;
+        const ContactPairs<dim>                   &pairs = state.pairs;
         for (unsigned int p = 0; p < pairs.size(); ++p)
-          if (contact.active[p])
+          if (state.contact.active[p])
             zone.emplace_back(pairs.points[p].position,
                               2 * pairs.rows[p].spacing(dim));
         for (const auto &cell : triangulation.active_cell_iterators())
@@ -148,7 +145,7 @@ namespace knee_contact
               if (cell->vertex(v).distance(centre) <= radius)
                 cell->set_refine_flag();
       }
-    mark_partners(triangulation, interfaces);
+    mark_partners(triangulation, state.interfaces);
     triangulation.execute_coarsening_and_refinement();
   }
 
@@ -235,21 +232,11 @@ namespace knee_contact
   template void
   Refinement::refine(const Strategy,
                      Triangulation<2> &,
-                     const DoFHandler<2> &,
-                     const Vector<double> &,
-                     const Materials<2> &,
-                     const ContactInterfaces &,
-                     const ContactPairs<2> &,
-                     const ContactSolution &,
+                     const ProblemAccess<2> &,
                      const Vector<float> *) const;
   template void
   Refinement::refine(const Strategy,
                      Triangulation<3> &,
-                     const DoFHandler<3> &,
-                     const Vector<double> &,
-                     const Materials<3> &,
-                     const ContactInterfaces &,
-                     const ContactPairs<3> &,
-                     const ContactSolution &,
+                     const ProblemAccess<3> &,
                      const Vector<float> *) const;
 } // namespace knee_contact

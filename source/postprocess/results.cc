@@ -16,17 +16,18 @@ namespace knee_contact
 {
   template <int dim>
   Results<dim>
-  compute_results(const DoFHandler<dim>           &dof_handler,
-                  const std::vector<unsigned int> &body_of_cell,
-                  const SparseMatrix<double>      &matrix,
-                  const Vector<double>            &rhs,
-                  const Vector<double>            &solution,
-                  const Materials<dim>            &materials,
-                  const BoundaryConditions<dim>   &boundary_conditions,
-                  const ContactInterfaces         &interfaces,
-                  const ContactPairs<dim>         &pairs,
-                  const ContactSolution           &contact)
+  compute_results(const ProblemAccess<dim> &state)
   {
+    const auto &[dof_handler,
+                 body_of_cell,
+                 matrix,
+                 rhs,
+                 solution,
+                 materials,
+                 boundary_conditions,
+                 interfaces,
+                 pairs,
+                 contact] = state;
     Results<dim> results;
     results.n_dofs   = dof_handler.n_dofs();
     results.n_cells  = dof_handler.get_triangulation().n_active_cells();
@@ -224,25 +225,7 @@ namespace knee_contact
 
 
   template Results<2>
-  compute_results(const DoFHandler<2> &,
-                  const std::vector<unsigned int> &,
-                  const SparseMatrix<double> &,
-                  const Vector<double> &,
-                  const Vector<double> &,
-                  const Materials<2> &,
-                  const BoundaryConditions<2> &,
-                  const ContactInterfaces &,
-                  const ContactPairs<2> &,
-                  const ContactSolution &);
+  compute_results(const ProblemAccess<2> &);
   template Results<3>
-  compute_results(const DoFHandler<3> &,
-                  const std::vector<unsigned int> &,
-                  const SparseMatrix<double> &,
-                  const Vector<double> &,
-                  const Vector<double> &,
-                  const Materials<3> &,
-                  const BoundaryConditions<3> &,
-                  const ContactInterfaces &,
-                  const ContactPairs<3> &,
-                  const ContactSolution &);
+  compute_results(const ProblemAccess<3> &);
 } // namespace knee_contact

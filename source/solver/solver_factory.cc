@@ -81,17 +81,19 @@ namespace knee_contact
 
 
 
-  std::unique_ptr<ContactSystem>
-  make_contact_system(const SolverPath                 requested,
-                      const SparseMatrix<double>      &matrix,
-                      const AffineConstraints<double> &base,
-                      const std::vector<ContactRow>   &pairs,
-                      const RigidModeCheck            &rigid_modes,
-                      const KrylovSettings            &krylov,
-                      const bool                       warm_start,
-                      std::ostream                    &log,
-                      std::string                     &name,
-                      std::map<std::string, double>   &figures)
+  // make_contact_system()'s choice, with its name and figures written as it
+  // goes (its branches return from several places).
+  static std::unique_ptr<ContactSystem>
+  choose(const SolverPath                 requested,
+         const SparseMatrix<double>      &matrix,
+         const AffineConstraints<double> &base,
+         const std::vector<ContactRow>   &pairs,
+         const RigidModeCheck            &rigid_modes,
+         const KrylovSettings            &krylov,
+         const bool                       warm_start,
+         std::ostream                    &log,
+         std::string                     &name,
+         std::map<std::string, double>   &figures)
   {
     figures["ranks"] = parallel::n_ranks();
     if (requested == SolverPath::step41)
@@ -400,5 +402,31 @@ namespace knee_contact
     log << "   solver: sparse (" << reason << ")" << on_every_rank()
         << std::endl;
     return sparse;
+  }
+
+
+
+  SolverChoice
+  make_contact_system(const SolverPath                 requested,
+                      const SparseMatrix<double>      &matrix,
+                      const AffineConstraints<double> &base,
+                      const std::vector<ContactRow>   &pairs,
+                      const RigidModeCheck            &rigid_modes,
+                      const KrylovSettings            &krylov,
+                      const bool                       warm_start,
+                      std::ostream                    &log)
+  {
+    SolverChoice choice;
+    choice.system = choose(requested,
+                           matrix,
+                           base,
+                           pairs,
+                           rigid_modes,
+                           krylov,
+                           warm_start,
+                           log,
+                           choice.name,
+                           choice.figures);
+    return choice;
   }
 } // namespace knee_contact

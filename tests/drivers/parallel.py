@@ -12,7 +12,8 @@
    to 1e-2 of the largest bar.
    The distributed iterative path (Contact/Solver = iterative: CG and AMG
    over the ranks, to 1e-12 of the load; with 3D friction its Newton
-   springs) and the direct paths (whole on each rank) both; measured: at most 1.1e-11 (the 3D knee at 2.3e5 dofs,
+   springs) and the direct paths (whole on each rank) both; adaptive
+   refinement (3D, goal-oriented) and a 2D study of both sequences; measured: at most 1.1e-11 (the 3D knee at 2.3e5 dofs,
    doc/parallel.md).
 2. More ranks than cells on a body and than vertices: a block of one cell
    on a base of 4 x 2 (19 vertices), 24 ranks, the iterative path (ranks
@@ -53,7 +54,13 @@ SCENES = [("contact_patch_3d_tet_iterative.prm", None, 2, []),
           ("friction_sliding_block_3d.prm", "iterative", 2,
            [("9.5533; 2.9552; 0", "0.0095533; 0.0029552; 0"),
             (r"\nsubsection Verification\n(.*\n)*?end\n", "\n")]),
-          ("load_cases_patch.prm", "iterative", 2, [])]
+          ("load_cases_patch.prm", "iterative", 2, []),
+          # Refinement: three adaptive cycles of goal-oriented refinement
+          # in 3D on the distributed path, and the uniform and adaptive
+          # sequences of a 2D study (its last mesh's results) on the
+          # direct path.
+          ("hertz_sphere_3d_adaptive.prm", "iterative", 2, []),
+          ("hertz_study_small.prm", None, 2, [])]
 TOLERANCE = 1e-8
 BAR_TOLERANCE = 1e-2
 # Round-off measures and what depends on the path taken, not the answer.

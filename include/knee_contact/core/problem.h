@@ -7,6 +7,7 @@
 #include <knee_contact/physics/materials.h>
 #include <knee_contact/postprocess/load_cases.h>
 #include <knee_contact/postprocess/output.h>
+#include <knee_contact/postprocess/problem_access.h>
 #include <knee_contact/postprocess/recovery.h>
 #include <knee_contact/postprocess/refinement.h>
 #include <knee_contact/postprocess/results.h>
@@ -237,6 +238,10 @@ namespace knee_contact
     /** The derived quantities (compute_results()) of the current solution. */
     Results<dim>
     current_results() const;
+
+    /** The read-only view of this problem its collaborators take. */
+    ProblemAccess<dim>
+    access() const;
 
     /**
      * The reported quantities of @p results by the names the error

@@ -1,9 +1,7 @@
 #ifndef knee_contact_refinement_h
 #define knee_contact_refinement_h
 
-#include <knee_contact/contact/contact.h>
-#include <knee_contact/physics/materials.h>
-#include <knee_contact/solver/active_set.h>
+#include <knee_contact/postprocess/problem_access.h>
 
 #include <deal.II/base/parameter_handler.h>
 
@@ -46,11 +44,11 @@ namespace knee_contact
     check_parameters();
 
     /**
-     * Refine @p triangulation once with @p strategy (global or adaptive)
-     * using the solution on it. The adaptive indicator is deal.II's Kelly
-     * estimator of the displacement gradient jumps, weighted by sqrt(E) of
-     * each cell so that it estimates the energy norm error a(e, e)^1/2
-     * across materials; refinement by fixed fraction of the estimate.
+     * Refine @p triangulation (the one of @p state) once with @p strategy
+     * (global or adaptive) using the solution on it. The adaptive indicator is
+     * deal.II's Kelly estimator of the displacement gradient jumps, weighted by
+     * sqrt(E) of each cell so that it estimates the energy norm error a(e,
+     * e)^1/2 across materials; refinement by fixed fraction of the estimate.
      * With @p goal (one value per active cell: the cells' shares of a
      * quantity's goal-oriented error estimate, as Target quantity's peak
      * pressure has) that indicator takes Kelly's place: the refinement
@@ -58,15 +56,10 @@ namespace knee_contact
      */
     template <int dim>
     void
-    refine(const Strategy           strategy,
-           Triangulation<dim>      &triangulation,
-           const DoFHandler<dim>   &dof_handler,
-           const Vector<double>    &solution,
-           const Materials<dim>    &materials,
-           const ContactInterfaces &interfaces,
-           const ContactPairs<dim> &pairs,
-           const ContactSolution   &contact,
-           const Vector<float>     *goal = nullptr) const;
+    refine(const Strategy            strategy,
+           Triangulation<dim>       &triangulation,
+           const ProblemAccess<dim> &state,
+           const Vector<float>      *goal = nullptr) const;
 
     static std::string
     name(const Strategy strategy);

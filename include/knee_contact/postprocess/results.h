@@ -4,6 +4,7 @@
 #include <knee_contact/contact/contact.h>
 #include <knee_contact/physics/boundary_conditions.h>
 #include <knee_contact/physics/materials.h>
+#include <knee_contact/postprocess/problem_access.h>
 #include <knee_contact/solver/active_set.h>
 
 #include <deal.II/base/geometry_info.h>
@@ -109,16 +110,7 @@ namespace knee_contact
 
   template <int dim>
   Results<dim>
-  compute_results(const DoFHandler<dim>           &dof_handler,
-                  const std::vector<unsigned int> &body_of_cell,
-                  const SparseMatrix<double>      &matrix,
-                  const Vector<double>            &rhs,
-                  const Vector<double>            &solution,
-                  const Materials<dim>            &materials,
-                  const BoundaryConditions<dim>   &boundary_conditions,
-                  const ContactInterfaces         &interfaces,
-                  const ContactPairs<dim>         &pairs,
-                  const ContactSolution           &contact);
+  compute_results(const ProblemAccess<dim> &state);
 } // namespace knee_contact
 
 #endif

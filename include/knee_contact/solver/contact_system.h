@@ -527,6 +527,18 @@ namespace knee_contact
   std::string
   solver_path_name(const SolverPath path);
 
+  /** What make_contact_system() chose. */
+  struct SolverChoice
+  {
+    std::unique_ptr<ContactSystem> system;
+    /** The path taken: condensed, sparse, iterative or step-41. */
+    std::string name;
+    /** The estimates behind the choice (summary.json's "solver"). */
+    std::map<std::string, double> figures;
+  };
+
+
+
   /**
    * The one factory of the solver seam. For SolverPath::automatic it
    * estimates, before allocating, the time (flops) and peak memory of the
@@ -538,9 +550,9 @@ namespace knee_contact
    * if none fits the run is refused in one line naming the estimate and
    * the limit. @p warm_start: the loop starts from a guess (a refined
    * mesh, a further load case), so fewer iterations are expected. @p log
-   * gets one line saying which path and why; @p name receives the path.
+   * gets one line saying which path and why.
    */
-  std::unique_ptr<ContactSystem>
+  SolverChoice
   make_contact_system(const SolverPath                 requested,
                       const SparseMatrix<double>      &matrix,
                       const AffineConstraints<double> &base,
@@ -548,9 +560,7 @@ namespace knee_contact
                       const RigidModeCheck            &rigid_modes,
                       const KrylovSettings            &krylov,
                       const bool                       warm_start,
-                      std::ostream                    &log,
-                      std::string                     &name,
-                      std::map<std::string, double>   &figures);
+                      std::ostream                    &log);
 
 
 

@@ -1,0 +1,162 @@
+#!/usr/bin/python3
+"""A scaling model of knee_contact under mpirun, from measured per-rank costs.
+
+Used by parallel_scaling.py --model (which runs the scene and passes the
+runs' numbers in); the arithmetic is here so that tests/unit can check it
+on numbers made by a known model (tests/drivers/scaling_model_check.py).
+
+A run is split into what its summary.json times (rank 0):
+
+  K  the Krylov iterations of the iterative path (distributed),
+  A  the AMG set-up (distributed),
+  W  the output (rank 0 alone writes; the others wait),
+  R  everything else: gmsh, reading, DoFs, assembly, contact search, the
+     active-set loop's replicated decisions, the error bars' strain
+     recovery (replicated on every rank in this stage of issue 38).
+
+On a machine of C cores with N ranks (o = max(1, N / C) ranks per core):
+
+  R(N) = R1 * beta * o               beta: two ranks sharing the memory
+                                     bandwidth (measured at N = 2), 1 at N = 1
+  K(N) = I * (k1 / min(N, C) + c2 * log2 N)
+                                     k1: time per CG iteration on one rank,
+                                     c2: the excess per iteration at N = 2
+                                     (halo exchanges, reductions, the
+                                     constraints' ghosts, bandwidth), taken
+                                     to grow as the depth of a reduction tree
+  A(N) = A1 / min(N, C) + a2 * log2 N
+  W(N) = W1
+  I    = I1 (ML aggregates within each rank; the METIS partition keeps
+         the iterations of one rank: an assumption the N = 4 run checks)
+
+Memory per rank: the replicated part (the peak of one rank less its
+iterative path) plus the path's replicated vectors and its divided matrix
+and hierarchy, P(N) = Pr + Pd / N (Pr, Pd from N = 1, 2).
+
+For 1e7 and 1e8 DoFs on 16-256 ranks (no cluster is reachable here) the
+same costs per DoF are extrapolated twice: for this stage (the mesh, the
+stiffness matrix and the replicated work on every rank) and for the
+distributed stage the issue asks for (every term divided, the master
+surface gathered), with the network's latency and bandwidth assumed
+(ASSUMED_NETWORK) and the CG iterations growing as n^alpha (alpha from
+two sizes measured in the same invocation).
+"""
+import math
+
+# An InfiniBand EDR-class cluster: the latency of a small message and the
+# bandwidth of one rank's link (assumed, not measured here).
+ASSUMED_NETWORK = {"latency_s": 2e-6, "bandwidth_Bps": 10e9}
+# Per CG iteration of the distributed stage: two reductions (CG's inner
+# products), and an AMG V-cycle of LEVELS levels with a halo exchange per
+# smoothing sweep and residual (4 a level) with NEIGHBOURS ranks each, plus
+# the operator's own halo exchange.
+LEVELS = 4
+NEIGHBOURS = 12
+# Bytes of a halo: 3 doubles per vertex on the surface of a rank's part
+# (6 faces of a cube of n / N / 3 vertices).
+HALO_BYTES_PER_VERTEX = 3 * 8
+# Bytes per master-surface face gathered (3 vertices: coordinates, dofs,
+# normal).
+FACE_BYTES = 3 * (3 * 8 + 3 * 8 + 3 * 8)
+
+
+def replicated(run):
+    """R of a run (see the module's text)."""
+    return run["run"] - run["krylov"] - run["amg"] - run["output"]
+
+
+def fit(one, two):
+    """The model's constants from a run on one rank and one on two."""
+    r1 = replicated(one)
+    k1 = one["krylov"] / one["cg"]
+    path_two = two["path_measured"]
+    path_one = one["path_measured"]
+    divided = 2 * (path_one - path_two)
+    return {
+        "R1": r1,
+        "beta": replicated(two) / r1,
+        "k1": k1,
+        "c2": two["krylov"] / two["cg"] - k1 / 2,
+        "A1": one["amg"],
+        "a2": two["amg"] - one["amg"] / 2,
+        "W1": one["output"],
+        "I1": one["cg"],
+        "M_replicated": one["peak"] - path_one,
+        "P_replicated": path_one - divided,
+        "P_divided": divided,
+        "dofs": one["dofs"],
+    }
+
+
+def predict(model, ranks, cores, iterations=None):
+    """Time [s] and memory per rank [MB] of N ranks on this machine.
+
+    iterations: the CG iterations to assume (default the one-rank run's).
+    """
+    occupancy = max(1.0, ranks / cores)
+    busy = min(ranks, cores)
+    depth = math.log2(ranks)
+    cg = model["I1"] if iterations is None else iterations
+    terms = {
+        "R": model["R1"] * (model["beta"] if ranks > 1 else 1.0) * occupancy,
+        "K": cg * (model["k1"] / busy + model["c2"] * depth),
+        "A": model["A1"] / busy + model["a2"] * depth,
+        "W": model["W1"],
+    }
+    terms["run"] = terms["R"] + terms["K"] + terms["A"] + terms["W"]
+    path = model["P_replicated"] + model["P_divided"] / ranks
+    terms["path_memory"] = path
+    terms["memory"] = model["M_replicated"] + path
+    return terms
+
+
+def iteration_exponent(small, large):
+    """alpha of I ~ n^alpha from two sizes on one rank."""
+    return (math.log(large["cg"] / small["cg"]) /
+            math.log(large["dofs"] / small["dofs"]))
+
+
+def extrapolate(model, alpha, dofs, ranks, contact_faces_ref,
+                network=ASSUMED_NETWORK):
+    """Time [s] and memory per rank [MB] at @p dofs on @p ranks (one per
+    core), for this stage and for the distributed one.
+
+    Each cost per DoF is the one measured at model["dofs"]; the CG
+    iterations grow as n^alpha, the contact faces as n^(2/3).
+    """
+    scale = dofs / model["dofs"]
+    cg = model["I1"] * scale ** alpha
+    faces = contact_faces_ref * scale ** (2. / 3.)
+    depth = math.log2(ranks)
+    # This stage: R, W and the replicated memory grow with n and do not
+    # divide; the solve divides (its excess per iteration taken as the
+    # network's below, since on a cluster the ranks do not share one
+    # machine's memory bandwidth).
+    own = dofs / ranks
+    halo = 6 * (own / 3) ** (2. / 3.) * HALO_BYTES_PER_VERTEX
+    per_iteration_network = (
+        network["latency_s"] * (2 * depth + (4 * LEVELS + 1) * NEIGHBOURS) +
+        (4 * LEVELS + 1) * halo / network["bandwidth_Bps"])
+    # The work per iteration and the replicated work at the rate of two
+    # ranks sharing one machine's memory bandwidth (the N = 2 run: a
+    # cluster's node shares it among its cores too).
+    work = (model["k1"] + 2 * model["c2"]) * scale / ranks
+    solve = cg * (work + per_iteration_network) + \
+        model["A1"] * scale / ranks
+    replicated_work = model["R1"] * model["beta"] * scale
+    gather = faces * FACE_BYTES / network["bandwidth_Bps"] + \
+        network["latency_s"] * depth
+    stage = {
+        "run": replicated_work + solve + model["W1"] * scale,
+        "memory": (model["M_replicated"] + model["P_replicated"]) * scale +
+        model["P_divided"] * scale / ranks,
+    }
+    distributed = {
+        # R divides; W becomes one piece per rank (.pvtu).
+        "run": (replicated_work + model["W1"] * scale) / ranks + solve +
+        gather,
+        "memory": (model["M_replicated"] + model["P_replicated"] +
+                   model["P_divided"]) * scale / ranks +
+        faces * FACE_BYTES / 2**20,
+    }
+    return {"stage": stage, "distributed": distributed, "cg": cg}
