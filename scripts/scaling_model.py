@@ -9,9 +9,10 @@ A run is split into what its summary.json times (rank 0):
 
   K  the Krylov iterations of the iterative path (distributed),
   A  the AMG set-up (distributed),
-  W  the output (rank 0 alone writes; the others wait),
-  R  everything else: gmsh, reading, DoFs, assembly, contact search, the
-     active-set loop's replicated decisions, the error bars' strain
+  W  the work of rank 0 alone, while the others wait: the output, and
+     gmsh with the mesh checks (the run's wall time less its timers),
+  R  everything else: reading the mesh, DoFs, assembly, contact search,
+     the active-set loop's replicated decisions, the error bars' strain
      recovery (replicated on every rank in this stage of issue 38).
 
 On a machine of C cores with N ranks (o = max(1, N / C) ranks per core):

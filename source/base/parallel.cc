@@ -241,5 +241,33 @@ namespace knee_contact
         say("");
       return code;
     }
+
+
+
+    void
+    broadcast_from_first(std::string &bytes)
+    {
+      if (n_ranks() == 1)
+        return;
+      unsigned long long size = bytes.size();
+      MPI_Request        request;
+      MPI_Ibcast(&size, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD, &request);
+      int arrived = 0;
+      while (true)
+        {
+          MPI_Test(&request, &arrived, MPI_STATUS_IGNORE);
+          if (arrived)
+            break;
+          std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        }
+      bytes.resize(size);
+      const unsigned long long piece = 1ull << 30;
+      for (unsigned long long start = 0; start < size; start += piece)
+        MPI_Bcast(bytes.data() + start,
+                  int(std::min(piece, size - start)),
+                  MPI_CHAR,
+                  0,
+                  MPI_COMM_WORLD);
+    }
   } // namespace parallel
 } // namespace knee_contact

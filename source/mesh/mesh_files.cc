@@ -1,5 +1,6 @@
 #include <knee_contact/base/input.h>
 #include <knee_contact/base/interruption.h>
+#include <knee_contact/base/parallel.h>
 #include <knee_contact/mesh/gmsh_input.h>
 #include <knee_contact/mesh/mesh.h>
 #include <knee_contact/mesh/mesh_readers.h>
@@ -11,13 +12,16 @@
 #include <array>
 #include <cmath>
 #include <cstdlib>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <numeric>
 #include <sstream>
+#include <stdexcept>
 #include <tuple>
 
 
@@ -59,14 +63,26 @@ namespace knee_contact
      */
     std::unique_ptr<CheckedMsh> kept_msh;
 
-    std::unique_ptr<CheckedMsh>
-    checked_msh(const std::string              &file,
-                const std::vector<std::string> &arguments,
-                const gmsh_input::Limits       &limits)
+    /** A private temporary folder for @p result's mesh (removed with it). */
+    void
+    make_folder(CheckedMsh &result)
     {
-      if (kept_msh && kept_msh->file == file &&
-          kept_msh->arguments == arguments)
-        return std::move(kept_msh);
+      std::string folder =
+        (std::filesystem::temp_directory_path() / "knee_contact_XXXXXX")
+          .string();
+      AssertThrow(mkdtemp(folder.data()) != nullptr,
+                  ExcMessage("cannot create a temporary folder for gmsh"));
+      interruption::register_folder(folder);
+      result.folder = folder;
+      result.msh    = folder + "/mesh.msh";
+    }
+
+    /** checked_msh() on this process alone. */
+    std::unique_ptr<CheckedMsh>
+    check_here(const std::string              &file,
+               const std::vector<std::string> &arguments,
+               const gmsh_input::Limits       &limits)
+    {
       auto result       = std::make_unique<CheckedMsh>();
       result->file      = file;
       result->arguments = arguments;
@@ -74,14 +90,7 @@ namespace knee_contact
       const bool geo    = std::filesystem::path(file).extension() == ".geo";
       if (geo || gmsh_input::is_binary_msh(file))
         {
-          std::string folder =
-            (std::filesystem::temp_directory_path() / "knee_contact_XXXXXX")
-              .string();
-          AssertThrow(mkdtemp(folder.data()) != nullptr,
-                      ExcMessage("cannot create a temporary folder for gmsh"));
-          interruption::register_folder(folder);
-          result->folder = folder;
-          result->msh    = folder + "/mesh.msh";
+          make_folder(*result);
           if (geo)
             gmsh_input::mesh(file, result->msh, arguments, limits);
           else
@@ -102,6 +111,101 @@ namespace knee_contact
                             result->msh.size() + 2,
                             "the mesh gmsh made of '" + file + "',");
           AssertThrow(false, ExcMessage(message));
+        }
+      return result;
+    }
+
+    /**
+     * @p file (a .msh or a .geo gmsh meshes with @p arguments) checked and
+     * ready to read. Under mpirun rank 0 alone runs gmsh and checks; the
+     * others take its outcome: its failure (the same one-line error, said
+     * once by rank 0), the user's .msh as checked, or the bytes of the mesh
+     * gmsh made, written into a folder of their own (no file system shared
+     * between the ranks' machines is assumed). Every rank running gmsh took
+     * N gmsh processes, each allowed a quarter of the machine's memory, and
+     * N times gmsh's time where ranks outnumber cores.
+     */
+    std::unique_ptr<CheckedMsh>
+    checked_msh(const std::string              &file,
+                const std::vector<std::string> &arguments,
+                const gmsh_input::Limits       &limits)
+    {
+      if (kept_msh && kept_msh->file == file &&
+          kept_msh->arguments == arguments)
+        return std::move(kept_msh);
+      if (parallel::n_ranks() == 1)
+        return check_here(file, arguments, limits);
+
+      // Rank 0's outcome: empty, or the kind of its failure and its line.
+      std::unique_ptr<CheckedMsh> result;
+      std::exception_ptr          failure;
+      std::string                 outcome;
+      if (parallel::rank() == 0)
+        try
+          {
+            result = check_here(file, arguments, limits);
+          }
+        catch (const ExcMessage &exc)
+          {
+            std::ostringstream info;
+            exc.print_info(info);
+            outcome = "input\n" + input::one_line(info.str());
+            failure = std::current_exception();
+          }
+        catch (const std::runtime_error &exc)
+          {
+            outcome = "input\n" + input::one_line(exc.what());
+            failure = std::current_exception();
+          }
+        catch (...)
+          {
+            outcome = "internal\n";
+            failure = std::current_exception();
+          }
+      parallel::broadcast_from_first(outcome);
+      if (failure)
+        std::rethrow_exception(failure);
+      if (!outcome.empty())
+        {
+          const auto line = outcome.find('\n');
+          if (outcome.substr(0, line) == "input")
+            throw std::runtime_error(outcome.substr(line + 1));
+          throw std::logic_error("rank 0 failed to mesh or check '" + file +
+                                 "'");
+        }
+
+      // The dimension, and the mesh gmsh made (empty: the user's file).
+      std::string dim, made;
+      if (parallel::rank() == 0)
+        {
+          dim = std::to_string(result->dim);
+          if (result->msh != file)
+            {
+              std::ifstream in(result->msh, std::ios::binary);
+              made.assign(std::istreambuf_iterator<char>(in), {});
+              AssertThrow(in.good() || in.eof(),
+                          ExcMessage("cannot read the mesh gmsh made of '" +
+                                     file + "'"));
+            }
+        }
+      parallel::broadcast_from_first(dim);
+      parallel::broadcast_from_first(made);
+      if (parallel::rank() == 0)
+        return result;
+      result            = std::make_unique<CheckedMsh>();
+      result->file      = file;
+      result->arguments = arguments;
+      result->msh       = file;
+      result->dim       = std::stoul(dim);
+      if (!made.empty())
+        {
+          make_folder(*result);
+          std::ofstream out(result->msh, std::ios::binary);
+          out.write(made.data(), made.size());
+          out.close();
+          AssertThrow(out.good(),
+                      ExcMessage("cannot write the mesh gmsh made of '" + file +
+                                 "' into a temporary folder"));
         }
       return result;
     }

@@ -19,7 +19,8 @@
    on a base of 4 x 2 (19 vertices), 24 ranks, the iterative path (ranks
    that own no row still take part in every collective operation).
 3. Bad input under mpirun: exit code 1 and the one-line error printed once
-   (not once per rank).
+   (not once per rank); also a .geo gmsh refuses (rank 0 alone runs gmsh,
+   the others take its failure).
 Usage: parallel.py KNEE_CONTACT
 """
 import csv
@@ -337,6 +338,30 @@ def main():
               (result.returncode, len(said), said))
         if result.returncode != 1 or len(said) != 1 or "Young" not in said[0]:
             failures.append("bad input on 2 ranks: exit code %d, error "
+                            "lines %s" % (result.returncode, said))
+
+        # A .geo gmsh refuses: rank 0 alone meshes, the others take its
+        # failure; said once, the same exit code.
+        geo = os.path.join(folder, "broken.geo")
+        with open(geo, "w") as f:
+            f.write("Point(1) = {0, 0, 0, 1};\nLine(1) = {1, 2};\n")
+        with open(os.path.join(SCENES_FOLDER,
+                               "contact_patch_3d_tet_iterative.prm")) as f:
+            text = f.read()
+        text = re.sub(r"set File\s*=.*", "set File = " + geo, text)
+        text = re.sub(r"set Folder\s*=.*",
+                      "set Folder = " + os.path.join(folder, "geo"), text)
+        broken = os.path.join(folder, "broken.prm")
+        with open(broken, "w") as f:
+            f.write(text)
+        result = run(binary, broken, 2)
+        said = [line for line in result.stderr.splitlines()
+                if line.startswith("knee_contact: error:")]
+        print("broken .geo on 2 ranks: exit code %d, %d error line(s): %s" %
+              (result.returncode, len(said), said))
+        if result.returncode != 1 or len(said) != 1 or \
+                "gmsh failed" not in said[0]:
+            failures.append("broken .geo on 2 ranks: exit code %d, error "
                             "lines %s" % (result.returncode, said))
     for failure in failures:
         print("FAIL " + failure)

@@ -71,6 +71,16 @@ namespace knee_contact
      */
     int
     finish(const int code, const std::string &message, const double seconds);
+
+    /**
+     * Rank 0's @p bytes on every rank (resized there), in pieces of at most
+     * 1 GB (MPI counts are int). A rank waiting for rank 0 sleeps between
+     * polls instead of spinning in MPI's progress loop, which took a core
+     * from gmsh on a machine of fewer cores than ranks: the first piece is
+     * sent as soon as rank 0 arrives, after work of any length (its gmsh).
+     */
+    void
+    broadcast_from_first(std::string &bytes);
   } // namespace parallel
 } // namespace knee_contact
 
