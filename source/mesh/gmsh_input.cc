@@ -1,6 +1,7 @@
 #include <knee_contact/base/external_program.h>
 #include <knee_contact/base/input.h>
 #include <knee_contact/base/memory.h>
+#include <knee_contact/base/parallel.h>
 #include <knee_contact/mesh/gmsh_input.h>
 
 #include <algorithm>
@@ -65,10 +66,13 @@ namespace knee_contact
       // gmsh is a process of its own: the memory of the machine counts,
       // not this process's address space; at least the 256 MB it needs to
       // start and mesh small scenes (200 MB measured), at most the
-      // address-space limit it would inherit.
-      std::string which;
-      return std::min(std::max(memory::available(which, false) / 4,
-                               256 * 1048576.),
+      // address-space limit it would inherit. Under mpirun one gmsh runs
+      // (on rank 0) for the ranks of this machine: the machine's share,
+      // not one rank's.
+      std::string  which;
+      const double machine =
+        memory::available(which, false) * parallel::ranks_on_this_machine();
+      return std::min(std::max(machine / 4, 256 * 1048576.),
                       memory::address_space_limit());
     }
 

@@ -23,6 +23,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <sstream>
 
 namespace knee_contact
@@ -104,15 +105,6 @@ namespace knee_contact
         : matrix(matrix)
         , springs(springs)
       {
-        // Each spring's owned entries (dof, coefficient).
-        for (const auto &spring : springs)
-          {
-            std::vector<std::pair<types::global_dof_index, double>> local;
-            for (const auto &[i, a] : spring.w)
-              if (owned.is_element(i))
-                local.emplace_back(i, a);
-            owned_w.push_back(std::move(local));
-          }
         const MPI_Comm comm = matrix.get_mpi_communicator();
         IndexSet       masters(owned.size());
         for (const auto &line : constraints.get_lines())
@@ -131,61 +123,122 @@ namespace knee_contact
         product.reinit(owned, comm);
         for (const auto &line : lines)
           diagonal.push_back(matrix.diag_element(line.index));
+
+        // Every index the products touch, as Epetra's local index into the
+        // vectors' arrays, found once per operator instead of by Epetra's
+        // global-to-local lookup (a search on a METIS partition's
+        // scattered rows) per entry and product.
+        const auto local_in = [](const TrilinosWrappers::MPI::Vector &v,
+                                 const types::global_dof_index        i) {
+          const int lid =
+            v.trilinos_vector().Map().LID(TrilinosWrappers::types::int_type(i));
+          AssertThrow(lid >= 0, ExcInternalError());
+          return lid;
+        };
+        for (const auto &line : lines)
+          {
+            line_local.push_back(local_in(spread, line.index));
+            std::vector<Entry> entries;
+            for (const auto &[master, weight] : line.entries)
+              entries.push_back(
+                {local_in(ghosted, master),
+                 owned.is_element(master) ? local_in(spread, master) : -1,
+                 master,
+                 weight});
+            line_entries.push_back(std::move(entries));
+          }
+        // Each spring's owned entries (local index, coefficient).
+        for (const auto &spring : springs)
+          {
+            std::vector<std::pair<int, double>> local;
+            for (const auto &[i, a] : spring.w)
+              if (owned.is_element(i))
+                local.emplace_back(local_in(spread, i), a);
+            owned_w.push_back(std::move(local));
+          }
       }
 
       void
       vmult(TrilinosWrappers::MPI::Vector       &dst,
             const TrilinosWrappers::MPI::Vector &src) const
       {
+        Assert(
+          src.trilinos_vector().Map().SameAs(spread.trilinos_vector().Map()) &&
+            dst.trilinos_vector().Map().SameAs(spread.trilinos_vector().Map()),
+          ExcInternalError());
         ghosted = src;
         spread  = src;
-        for (const auto &line : lines)
-          {
-            double value = 0;
-            for (const auto &[master, weight] : line.entries)
-              value += weight * ghosted(master);
-            spread(line.index) = value;
-          }
+        {
+          const double *x = ghosted.trilinos_vector()[0];
+          double       *y = spread.trilinos_vector()[0];
+          for (unsigned int k = 0; k < lines.size(); ++k)
+            {
+              double value = 0;
+              for (const Entry &entry : line_entries[k])
+                value += entry.weight * x[entry.ghosted];
+              y[line_local[k]] = value;
+            }
+        }
         matrix.vmult(product, spread);
+        double *r = product.trilinos_vector()[0];
         if (!springs.empty())
           {
             // w . x over the ranks' owned entries, summed by one reduction
             // for all springs.
+            const double       *x = spread.trilinos_vector()[0];
             std::vector<double> stretch(springs.size(), 0.);
             for (unsigned int k = 0; k < springs.size(); ++k)
               for (const auto &[i, a] : owned_w[k])
-                stretch[k] += a * spread(i);
+                stretch[k] += a * x[i];
             Utilities::MPI::sum(stretch,
                                 matrix.get_mpi_communicator(),
                                 stretch);
             for (unsigned int k = 0; k < springs.size(); ++k)
               for (const auto &[i, a] : owned_w[k])
-                product(i) += springs[k].stiffness * stretch[k] * a;
+                r[i] += springs[k].stiffness * stretch[k] * a;
           }
+        // T^T r: a constrained row's result goes to its masters, to an
+        // owned master in place, to another rank's through to_masters.
         to_masters = 0;
-        for (const auto &line : lines)
-          {
-            const double value = product(line.index);
-            for (const auto &[master, weight] : line.entries)
-              to_masters(master) += weight * value;
-          }
+        for (unsigned int k = 0; k < lines.size(); ++k)
+          for (const Entry &entry : line_entries[k])
+            if (entry.owned < 0)
+              to_masters(entry.global) += entry.weight * r[line_local[k]];
         to_masters.compress(VectorOperation::add);
         dst = product;
         dst += to_masters;
+        double       *d = dst.trilinos_vector()[0];
+        const double *s = src.trilinos_vector()[0];
         for (unsigned int k = 0; k < lines.size(); ++k)
-          dst(lines[k].index) = diagonal[k] * src(lines[k].index);
+          for (const Entry &entry : line_entries[k])
+            if (entry.owned >= 0)
+              d[entry.owned] += entry.weight * r[line_local[k]];
+        for (unsigned int k = 0; k < lines.size(); ++k)
+          d[line_local[k]] = diagonal[k] * s[line_local[k]];
         ++n_products;
       }
 
       mutable unsigned int n_products = 0;
 
     private:
-      const TrilinosWrappers::SparseMatrix &matrix;
-      const std::vector<SpringTerm>        &springs;
-      std::vector<std::vector<std::pair<types::global_dof_index, double>>>
-        owned_w;
+      /** A master of a constrained row: its local index in the ghosted
+       * vector, in the owned vectors (-1: another rank's), its global index
+       * and weight. */
+      struct Entry
+      {
+        int                     ghosted;
+        int                     owned;
+        types::global_dof_index global;
+        double                  weight;
+      };
+
+      const TrilinosWrappers::SparseMatrix            &matrix;
+      const std::vector<SpringTerm>                   &springs;
+      std::vector<std::vector<std::pair<int, double>>> owned_w;
       /** The constrained dofs of this rank with their masters. */
       std::vector<AffineConstraints<double>::ConstraintLine> lines;
+      std::vector<int>                                       line_local;
+      std::vector<std::vector<Entry>>                        line_entries;
       std::vector<double>                                    diagonal;
       mutable TrilinosWrappers::MPI::Vector spread, ghosted, to_masters,
         product;
