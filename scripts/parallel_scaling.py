@@ -144,7 +144,7 @@ def main():
             "cg": median(lambda s: s["solver"].get("krylov_iterations", 0)),
             "estimate": median(
                 lambda s: s["solver"].get("estimated_iterative_MB", 0)),
-            "measured": median(
+            "path_measured": median(
                 lambda s: s["solver"].get("iterative_memory_MB", 0)),
             "peak": median(lambda s: s["solver"].get("peak_memory_MB", 0)),
             "output": statistics.median(
@@ -165,7 +165,7 @@ def main():
                   row["solve"], row["krylov"], row["amg"], row["cg"],
                   base["run"] / row["run"],
                   base["solve"] / max(row["solve"], 1e-9), row["estimate"],
-                  row["measured"], row["peak"], row["difference"]))
+                  row["path_measured"], row["peak"], row["difference"]))
     if args.model:
         small = None
         if args.small:
@@ -184,8 +184,6 @@ def print_model(rows, small):
     by_ranks = {row["ranks"]: row for row in rows}
     if 1 not in by_ranks or 2 not in by_ranks:
         sys.exit("--model needs runs on 1 and 2 ranks")
-    for row in rows:
-        row["path_measured"] = row["measured"]
     model = scaling_model.fit(by_ranks[1], by_ranks[2])
     cores = os.cpu_count()
     print("\nModel (scripts/scaling_model.py) fitted to N = 1, 2 on %d cores:"

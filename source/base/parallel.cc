@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <streambuf>
 #include <thread>
@@ -18,6 +19,25 @@ namespace knee_contact
   {
     namespace
     {
+      /**
+       * Wait for @p request, polling every 10 ms instead of spinning in
+       * MPI's progress loop (which takes a core from the work a waiting
+       * rank waits for), until it completes or @p give_up says so. Whether
+       * it completed.
+       */
+      bool
+      wait_asleep(MPI_Request &request, const std::function<bool()> &give_up)
+      {
+        int arrived = 0;
+        while (true)
+          {
+            MPI_Test(&request, &arrived, MPI_STATUS_IGNORE);
+            if (arrived || give_up())
+              return arrived;
+            std::this_thread::sleep_for(std::chrono::milliseconds(10));
+          }
+      }
+
       bool
       initialised()
       {
@@ -213,15 +233,10 @@ namespace knee_contact
       MPI_Ibarrier(MPI_COMM_WORLD, &request);
       const auto end = std::chrono::steady_clock::now() +
                        std::chrono::duration<double>(seconds);
-      int arrived = 0;
-      while (true)
-        {
-          MPI_Test(&request, &arrived, MPI_STATUS_IGNORE);
-          if (arrived || (code != 0 && std::chrono::steady_clock::now() > end))
-            break;
-          std::this_thread::sleep_for(std::chrono::milliseconds(10));
-        }
-      const auto say = [&](const std::string &suffix) {
+      const bool arrived = wait_asleep(request, [&]() {
+        return code != 0 && std::chrono::steady_clock::now() > end;
+      });
+      const auto say     = [&](const std::string &suffix) {
         if (cerr_buffer != nullptr)
           std::cerr.rdbuf(cerr_buffer);
         if (!message.empty())
@@ -252,14 +267,7 @@ namespace knee_contact
       unsigned long long size = bytes.size();
       MPI_Request        request;
       MPI_Ibcast(&size, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD, &request);
-      int arrived = 0;
-      while (true)
-        {
-          MPI_Test(&request, &arrived, MPI_STATUS_IGNORE);
-          if (arrived)
-            break;
-          std::this_thread::sleep_for(std::chrono::milliseconds(10));
-        }
+      wait_asleep(request, []() { return false; });
       bytes.resize(size);
       const unsigned long long piece = 1ull << 30;
       for (unsigned long long start = 0; start < size; start += piece)
