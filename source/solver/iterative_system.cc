@@ -319,8 +319,13 @@ namespace knee_contact
     std::vector<double>              null_space;
     unsigned int                     n_modes = 0;
 
-    /** The springs of the following solves (set_springs()). */
-    std::vector<SpringTerm> springs;
+    /** The springs of the following solves (set_springs()), as the loop
+     * gave them and on the dofs. */
+    std::vector<ContactSystem::Spring> given_springs;
+    std::vector<SpringTerm>            springs;
+    /** Those of the current solve left to the operator (the others are
+     * tied: springs::tie_stiff()). */
+    std::vector<SpringTerm> operator_springs;
     /** The rows of this rank (all of them on one). */
     IndexSet                       owned;
     AffineConstraints<double>      constraints;
@@ -333,10 +338,12 @@ namespace knee_contact
     TrilinosWrappers::SparseMatrix    distributed_matrix;
     TrilinosWrappers::PreconditionAMG amg;
     bool                              has_amg = false;
-    /** The set the hierarchy was built for. */
-    std::vector<bool> amg_active;
-    Vector<double>    x;
-    double            accuracy = 0;
+    /** The set the hierarchy was built for, and the dofs its tied
+     * springs eliminated. */
+    std::vector<bool>                    amg_active;
+    std::vector<types::global_dof_index> amg_tied;
+    Vector<double>                       x;
+    double                               accuracy = 0;
     /** set_accuracy()'s accuracy is of the start's residual. */
     bool accuracy_of_start = false;
     bool exact             = false;
@@ -355,7 +362,7 @@ namespace knee_contact
     {
       double       setup = 0, krylov = 0;
       unsigned int n_setups = 0, n_solves = 0, n_iterations = 0,
-                   max_iterations = 0;
+                   max_iterations = 0, n_over_budget = 0, n_tied = 0;
     } totals;
 
     void
@@ -378,7 +385,9 @@ namespace knee_contact
            SolverControl        &control,
            double               &target,
            const double          b_norm,
-           const double          target_relative);
+           const double          target_relative,
+           const double          budget_rate,
+           const double          budget_extra);
   };
 
 
@@ -550,7 +559,9 @@ namespace knee_contact
                                                  SolverControl        &control,
                                                  double               &target,
                                                  const double          b_norm,
-                                                 const double target_relative)
+                                                 const double target_relative,
+                                                 const double budget_rate,
+                                                 const double budget_extra)
   {
     // An inexact solve must still resolve what the new set changed: its
     // residual falls at least tenfold from the warm start's (an inexact
@@ -561,16 +572,26 @@ namespace knee_contact
     // iterations). A hundredfold cost 23 % more CG iterations on the knee
     // at 2.3e5 dofs (438 against 355) and 8 % on that Hertz sphere (795
     // against 733, both converging in 22 active-set iterations).
+    // (A target set by an earlier part of this solve stays.) With a
+    // budget rate, at most 1.5 x rate x decades + extra iterations.
     const auto set_target = [&](const double start_residual) {
-      target = std::max(settings.tolerance * b_norm,
-                        accuracy_of_start ? target_relative * start_residual
-                                          : std::min(target_relative * b_norm,
-                                                     1e-1 * start_residual));
+      if (target == 0)
+        target = std::max(settings.tolerance * b_norm,
+                          accuracy_of_start ? target_relative * start_residual
+                                            : std::min(target_relative * b_norm,
+                                                       1e-1 * start_residual));
       control.set_tolerance(target);
+      if (budget_rate > 0 && start_residual > target)
+        control.set_max_steps(std::min<double>(
+          control.max_steps(),
+          std::ceil(1.5 * budget_rate * std::log10(start_residual / target) +
+                    budget_extra)));
     };
     if (parallel::n_ranks() == 1)
       {
-        iterative::CondensedOperator operation(matrix, constraints, springs);
+        iterative::CondensedOperator operation(matrix,
+                                               constraints,
+                                               operator_springs);
         Vector<double>               start_residual(b.size());
         operation.vmult(start_residual, y);
         start_residual.sadd(-1., 1., b);
@@ -586,7 +607,7 @@ namespace knee_contact
     const iterative::DistributedCondensedOperator operation(distributed_matrix,
                                                             constraints,
                                                             owned,
-                                                            springs);
+                                                            operator_springs);
     const MPI_Comm                comm = parallel::communicator();
     TrilinosWrappers::MPI::Vector y_owned(owned, comm), b_owned(owned, comm),
       start_residual(owned, comm);
@@ -601,7 +622,17 @@ namespace knee_contact
     start_residual.sadd(-1., 1., b_owned);
     set_target(start_residual.l2_norm());
     SolverCG<TrilinosWrappers::MPI::Vector> cg(control);
-    cg.solve(operation, y_owned, b_owned, amg);
+    try
+      {
+        cg.solve(operation, y_owned, b_owned, amg);
+      }
+    catch (const SolverControl::NoConvergence &)
+      {
+        // The iterate so far, for a continuation (every rank is here:
+        // the residual is global).
+        y = Vector<double>(y_owned);
+        throw;
+      }
     // Every rank takes the whole solution (the rows and the results are
     // replicated).
     y = Vector<double>(y_owned);
@@ -673,11 +704,37 @@ namespace knee_contact
     Implementation &d = *implementation;
     Assert(d.rhs != nullptr, ExcMessage("set_rhs() was not called"));
     Timer clock;
-    ActiveSetSolver::make_constraints(d.base, d.pairs, active, d.constraints);
+    // The springs at least as stiff as C on their dofs are held as rows
+    // (springs::tie_stiff()). Measured on the 3D knee with friction (34 059
+    // dofs, two load cases): tying at 100 x C left springs of 1 to 100 x C,
+    // and the second case's CG did not converge in 1 000 iterations; at
+    // 1 x and 10 x the same springs are tied (their stiffnesses are far
+    // apart: most below 0.02 x, a few above 30 x), both cases converge in
+    // the Newton iterations of the sparse path (13 and 11); at 0.01 x the
+    // first took 15.
+    springs::Ties ties = springs::tie_stiff(
+      d.given_springs, d.springs, d.pairs, active, d.matrix, 1.);
+    std::vector<ContactRow>        extended;
+    const std::vector<ContactRow> *rows = &d.pairs;
+    std::vector<bool>              held = active;
+    if (!ties.for_constraints.empty())
+      {
+        extended = d.pairs;
+        extended.insert(extended.end(),
+                        ties.for_constraints.begin(),
+                        ties.for_constraints.end());
+        held.resize(extended.size(), true);
+        rows = &extended;
+      }
+    d.operator_springs = std::move(ties.kept);
+    d.totals.n_tied += ties.rows.size();
+    ActiveSetSolver::make_constraints(d.base, *rows, held, d.constraints);
     // The condensed right hand side T^T (d + sum k g_w w - K g), g the
     // inhomogeneities.
-    const Vector<double> b =
-      springs::condensed_load(d.springs, d.matrix, *d.rhs, d.constraints);
+    const Vector<double> b = springs::condensed_load(d.operator_springs,
+                                                     d.matrix,
+                                                     *d.rhs,
+                                                     d.constraints);
     d.condensation += clock.wall_time();
 
     // A hierarchy is kept while the CG iterations it costs beyond its rate
@@ -689,61 +746,140 @@ namespace knee_contact
     // 2.3e5 dofs, the rule below rebuilt it twice there, since the loop's
     // exact last solve converges at another rate than the loose first one).
     const bool stale = d.has_amg && d.time_per_product > 0 &&
-                       active != d.amg_active &&
+                       (active != d.amg_active || !ties.rows.empty()) &&
                        (d.last_iterations - d.last_decades * d.rate_at_build) *
                            d.time_per_product >
                          d.totals.setup / d.totals.n_setups;
+    // With springs, a set that moved by more than 5 % of its rows from the
+    // hierarchy's gets a new one: the friction loop moves a third to all of
+    // them in its first iterations (3D knee, 1.25e5 dofs: a kept hierarchy then
+    // took 300 to 500 CG iterations, a new one 150; a set-up costs about
+    // 30), the frictionless loop a few rows.
+    // So does a set whose tied springs changed dofs (3D knee, 2.3e5 dofs:
+    // kept across such a change, with the rows within 5 %, hierarchies
+    // ran out of their budgets of 240 to 460 iterations; fresh ones took
+    // 150 to 280).
+    unsigned int n_changed = 0, n_held = 0;
+    for (std::size_t i = 0; i < active.size(); ++i)
+      {
+        n_held += active[i];
+        n_changed += active[i] != (i < d.amg_active.size() && d.amg_active[i]);
+      }
+    std::vector<types::global_dof_index> tied;
+    for (const auto &row : ties.for_constraints)
+      tied.push_back(row.eliminated);
+    // (Only with springs: the frictionless loop keeps the rule above,
+    // which its measured times were tuned with; with these rules as well
+    // the 3D knee at 1.25e5 dofs without friction took 23.5 s against 9.0
+    // in its first case, 10 set-ups in 11 solves.)
+    const bool with_springs = !d.given_springs.empty();
+    const bool moved =
+      with_springs && (n_changed > 0.05 * n_held || tied != d.amg_tied);
     // The ranks measure their own times: rank 0's decision holds for all
-    // (the set-up is collective).
-    const bool fresh =
-      !d.has_amg ||
-      Utilities::MPI::broadcast(parallel::communicator(), stale, 0);
+    // (the set-up is collective; the sets are the same on every rank).
+    bool fresh = !d.has_amg || moved ||
+                 Utilities::MPI::broadcast(parallel::communicator(), stale, 0);
     if (fresh)
       {
         d.build_amg();
         d.amg_active = active;
+        d.amg_tied   = tied;
       }
 
     // Start from the previous solution on the free dofs.
     Vector<double> y = d.x;
     for (const auto &line : d.constraints.get_lines())
       y(line.index) = 0;
+    const Vector<double> start = y;
 
     const double target_relative = std::max(d.settings.tolerance, d.accuracy);
     d.exact                      = target_relative <= d.settings.tolerance;
     const double b_norm          = std::max(b.l2_norm(), 1e-300);
 
+    // With springs, a kept hierarchy gets a budget: 1.5 x the iterations a
+    // fresh one would take (its rate per decade of the residual) and those
+    // a new set-up costs. Past it the hierarchy is rebuilt and CG starts again,
+    // so that an operator that moved away from the hierarchy's costs at
+    // most about a set-up and a fresh solve more (the rule above decides
+    // from the last solve, and the friction loop changes its springs at
+    // every iteration: 3D knee, 34 059 dofs, kept hierarchies took up to
+    // 820 iterations where fresh ones took 100).
+    const bool budgeted = with_springs && !fresh && d.rate_at_build > 0 &&
+                          d.time_per_product > 0 && d.totals.n_setups > 0;
+    // (From rank 0's times: every rank must stop at the same iteration.)
+    const double budget_extra = Utilities::MPI::broadcast(
+      parallel::communicator(),
+      budgeted ? d.totals.setup / d.totals.n_setups / d.time_per_product : 0.,
+      0);
+
     double        target = 0;
     SolverControl control(d.settings.max_iterations, 0., false, false);
-    unsigned int  n_products = 0;
+    unsigned int  n_products = 0, n_iterations = 0;
+    double        rebuild_time = 0;
     clock.restart();
+    const auto failed = [&](const SolverControl::NoConvergence &failure) {
+      std::ostringstream message;
+      message << "the iterative solver (CG with ML's AMG) did not converge "
+              << "in " << n_iterations + failure.last_step
+              << " iterations (Contact/Krylov iterations): residual "
+              << failure.last_residual / b_norm << " of the target "
+              << target / b_norm
+              << " relative to the load; raise the limit, or take "
+                 "Contact/Solver = sparse where the factor fits";
+      AssertThrow(false, ExcMessage(message.str()));
+    };
     try
       {
-        n_products = d.krylov(y, b, control, target, b_norm, target_relative);
+        n_products = d.krylov(y,
+                              b,
+                              control,
+                              target,
+                              b_norm,
+                              target_relative,
+                              budgeted ? d.rate_at_build : 0.,
+                              budget_extra);
       }
     catch (const SolverControl::NoConvergence &failure)
       {
-        std::ostringstream message;
-        message << "the iterative solver (CG with ML's AMG) did not converge "
-                << "in " << failure.last_step
-                << " iterations (Contact/Krylov iterations): residual "
-                << failure.last_residual / b_norm << " of the target "
-                << target / b_norm
-                << " relative to the load; raise the limit, or take "
-                   "Contact/Solver = sparse where the factor fits";
-        AssertThrow(false, ExcMessage(message.str()));
+        if (!budgeted || failure.last_step >= d.settings.max_iterations)
+          failed(failure);
+        ++d.totals.n_over_budget;
+        // Over budget: a new hierarchy, the rest of the iterations, from
+        // the start again (from the iterate reached, the 3D knee at
+        // 124 551 dofs took 300 to 660 iterations more where a fresh start
+        // took 150: the kept hierarchy's iterates grow components the new
+        // one must first undo).
+        y            = start;
+        n_iterations = failure.last_step;
+        n_products   = failure.last_step + 1;
+        Timer rebuild;
+        d.build_amg();
+        d.amg_active = active;
+        d.amg_tied   = tied;
+        fresh        = true;
+        rebuild_time = rebuild.wall_time();
+        control.set_max_steps(d.settings.max_iterations - n_iterations);
+        try
+          {
+            n_products +=
+              d.krylov(y, b, control, target, b_norm, target_relative, 0, 0);
+          }
+        catch (const SolverControl::NoConvergence &failure)
+          {
+            failed(failure);
+          }
       }
-    const double time = clock.wall_time();
+    const double time = clock.wall_time() - rebuild_time;
     d.totals.krylov += time;
     d.time_per_product = time / std::max<unsigned int>(1, n_products);
-    d.last_iterations  = control.last_step();
+    d.last_iterations  = n_iterations + control.last_step();
     d.last_decades =
       std::log10(std::max(control.initial_value(), 1e-300) /
                  std::max(control.last_value(),
                           1e-300 * control.initial_value() + 1e-300));
     d.last_decades = std::max(d.last_decades, 0.5);
     if (fresh)
-      d.rate_at_build = d.last_iterations / d.last_decades;
+      d.rate_at_build = control.last_step() / d.last_decades;
     d.totals.n_iterations += d.last_iterations;
     d.totals.max_iterations =
       std::max(d.totals.max_iterations, d.last_iterations);
@@ -755,15 +891,20 @@ namespace knee_contact
     // side exist: the figure its estimate is checked against.
     if (d.totals.n_solves == 1)
       d.measured_MB = iterative::resident_MB() - d.resident_at_start;
+    if (!ties.for_multipliers.empty())
+      std::copy(ties.for_multipliers.begin(),
+                ties.for_multipliers.end(),
+                extended.begin() + d.pairs.size());
     ActiveSetSolver::excess_and_multipliers(d.matrix,
                                             *d.rhs,
                                             d.x,
                                             d.base,
-                                            d.pairs,
-                                            active,
+                                            *rows,
+                                            held,
                                             excess,
                                             lambda,
-                                            d.springs);
+                                            d.operator_springs);
+    springs::untie(ties, d.pairs.size(), excess, lambda);
   }
 
 
@@ -771,6 +912,7 @@ namespace knee_contact
   void
   IterativeContactSystem::set_springs(const std::vector<Spring> &springs)
   {
+    implementation->given_springs = springs;
     implementation->springs = springs::on_dofs(springs, implementation->pairs);
   }
 
@@ -832,6 +974,8 @@ namespace knee_contact
             {"krylov_solves", d.totals.n_solves},
             {"krylov_iterations", d.totals.n_iterations},
             {"krylov_iterations_max", d.totals.max_iterations},
+            {"krylov_over_budget", d.totals.n_over_budget},
+            {"tied_springs", d.totals.n_tied},
             {"krylov_time", d.totals.krylov},
             {"condensation", d.condensation},
             {"iterative_memory_MB", d.measured_MB},

@@ -42,7 +42,8 @@ step's springs in its dense multiplier system, 9-10 iterations), on the
 sparse one (the springs in each iteration's CHOLMOD factor), on step-41's
 (UMFPACK on the whole condensed system, the springs added before the
 condensation) and on the iterative one (the springs applied in CG with
-AMG); their energy and max |u| agree to 1e-8, and the three direct paths
+AMG, those as stiff as the matrix held as rows, which must happen at least
+once); their energy and max |u| agree to 1e-8, and the three direct paths
 take the same number of iterations (the same Newton loop on paths that
 solve each system exactly). The sparse path solves a system whose active
 set is its factor's but whose springs are new by CG on that factor: the
@@ -164,6 +165,10 @@ def main():
     # the last factor where the active set stayed): they must have been
     # taken, so that the comparison above covers them.
     stale_solves = 0
+    # The iterative path's springs held as rows (springs::tie_stiff()):
+    # they must have been taken, so that its comparison with the sparse
+    # path covers them.
+    tied_springs = 0
     with tempfile.TemporaryDirectory() as folder:
         # 1. mu = 0.
         for name, tolerance, plain, other in mu_zero_runs(
@@ -264,6 +269,8 @@ def main():
                         failures += difference > 1e-8
                         stale_solves += found["sparse"]["solver"][
                             "stale_factor_solves"]
+                        tied_springs += found["iterative"]["solver"][
+                            "tied_springs"]
                         counts = set(iterations(found[solver])
                                      for solver in ("automatic", "sparse",
                                                     "step-41"))
@@ -293,6 +300,9 @@ def main():
         print("the sparse path solved %d systems by CG on a factor with "
               "other springs (must be > 0)" % stale_solves)
         failures += stale_solves == 0
+        print("the iterative path held %d springs as rows (must be > 0)"
+              % tied_springs)
+        failures += tied_springs == 0
         # 5. The pictures of a frictional 3D interface: the pressure map
         # and the stick/slip map (scripts/plot_results_3d.py) are written.
         R = rotation(0.7)

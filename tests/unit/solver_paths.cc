@@ -139,10 +139,14 @@ namespace
     unsigned int n_active = 0;
     for (const bool a : step41.contact.active)
       n_active += a;
-    std::cout << scene << ": "
-              << (step41.error.empty() ? "exit " + std::to_string(step41.status)
-                                       : std::string("refused"))
-              << ", " << n_active << " active pairs";
+    // The line is printed whole after the runs, so that their refusals
+    // (on std::cerr, unbuffered) come before it wherever the file buffer
+    // of std::cout happens to be flushed.
+    std::ostringstream line;
+    line << scene << ": "
+         << (step41.error.empty() ? "exit " + std::to_string(step41.status)
+                                  : std::string("refused"))
+         << ", " << n_active << " active pairs";
     bool all = true;
     for (const Path path :
          {Path::condensed, Path::sparse, Path::automatic, Path::iterative})
@@ -150,14 +154,14 @@ namespace
         std::string why;
         const bool  ok =
           agrees(step41, run<dim>(scene, path), why, path == Path::iterative);
-        std::cout << ", " << solver_path_name(path) << " "
-                  << (ok ? "same" : "DIFFERENT");
+        line << ", " << solver_path_name(path) << " "
+             << (ok ? "same" : "DIFFERENT");
         if (!ok)
           std::cerr << scene << " (" << solver_path_name(path)
                     << " against step-41): " << why << std::endl;
         all = all && ok;
       }
-    std::cout << std::endl;
+    std::cout << line.str() << std::endl;
     return all;
   }
 } // namespace

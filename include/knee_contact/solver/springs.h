@@ -78,6 +78,61 @@ namespace knee_contact
                    const Vector<double>            &rhs,
                    const AffineConstraints<double> &constraints);
 
+    /**
+     * The springs of @p springs (on_dofs() of @p rows' springs) stiff
+     * beside the matrix, held as equalities instead: what a Krylov solver
+     * is left with by the others, and what it recovers afterwards.
+     */
+    struct Ties
+    {
+      /** The springs kept as springs (every other: tied). */
+      std::vector<SpringTerm> kept;
+      /**
+       * One row per tied spring, appended to the contact rows and held
+       * active: w . x = g_w. For the constraints its reduced row is w with
+       * the active rows that share its dofs subtracted (no row then holds
+       * another's eliminated dof: AffineConstraints has no cycles to
+       * close); for the multipliers, w itself.
+       */
+      std::vector<ContactRow> for_constraints, for_multipliers;
+      /** Of each tied spring: its stiffness and its rows (r, c_r). */
+      std::vector<double>                                       stiffness;
+      std::vector<std::vector<std::pair<unsigned int, double>>> rows;
+    };
+
+    /**
+     * Ties the springs whose stiffness on their own combination w exceeds
+     * @p ratio times the matrix's (k |w|^4 >= ratio sum_i w_i^2 C_ii): each
+     * adds one large eigenvalue to K = C + sum k w w^T, and CG pays about
+     * one iteration per outlier (the 3D knee's stance at 34 059 dofs: up to
+     * 4 682 a solve, against 100 without friction). Held as w . x = g_w
+     * instead, the spring's stretch is its multiplier divided by k: the
+     * semismooth Newton step with k -> infinity across the slip, which
+     * changes the step by a relative 1/ratio. A spring is kept where no
+     * dof of w is free to eliminate, or where its rows share dofs with an
+     * active row beyond w's (the row operation would leave the pattern).
+     */
+    Ties
+    tie_stiff(const std::vector<ContactSystem::Spring> &springs,
+              const std::vector<SpringTerm>            &terms,
+              const std::vector<ContactRow>            &rows,
+              const std::vector<bool>                  &active,
+              const SparseMatrix<double>               &matrix,
+              const double                              ratio);
+
+    /**
+     * After a solve with @p ties held (their multipliers at
+     * @p lambda[n_rows + t]): adds each tied spring's stretch
+     * lambda / k to the excess of its rows, as the spring would have
+     * stretched (w . x - g_w = sum_r c_r excess_r), and drops the tied
+     * rows from @p excess and @p lambda.
+     */
+    void
+    untie(const Ties          &ties,
+          const unsigned int   n_rows,
+          std::vector<double> &excess,
+          std::vector<double> &lambda);
+
     /** v += sum k (w . x) w. */
     void
     vmult_add(const std::vector<SpringTerm> &springs,
