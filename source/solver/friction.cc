@@ -207,7 +207,7 @@ namespace knee_contact
     // Inexact solves while the sets change (the iterative path; the direct
     // ones are exact): the first to 1e-2 of the load. Whatever follows the
     // loop (the error estimate's solves) asks for its own accuracy.
-    bool inexact = true;
+    bool inexact = true, had_inexact_solve = false;
     system.set_accuracy(1e-2);
     const auto finish = [&]() {
       system.set_accuracy(0);
@@ -600,6 +600,7 @@ namespace knee_contact
         // the sets change) is solved again to the final tolerance first,
         // as in solve().
         const bool exact         = system.last_solve_exact();
+        had_inexact_solve        = had_inexact_solve || !exact;
         const auto solve_exactly = [&]() {
           system.set_accuracy(0);
           inexact = false;
@@ -634,7 +635,9 @@ namespace knee_contact
           ++result.n_bound_updates;
         else if (seen.count({next, next_force}))
           {
-            if (inexact)
+            // (A cycle under inexact solves may be the Krylov solver's
+            // error: from here on every solve is exact.)
+            if (inexact && had_inexact_solve)
               {
                 solve_exactly();
                 continue;
