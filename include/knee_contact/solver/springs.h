@@ -103,14 +103,17 @@ namespace knee_contact
     /**
      * Ties the springs whose stiffness on their own combination w exceeds
      * @p ratio times the matrix's (k |w|^4 >= ratio sum_i w_i^2 C_ii): each
-     * adds one large eigenvalue to K = C + sum k w w^T, and CG pays about
-     * one iteration per outlier (the 3D knee's stance at 34 059 dofs: up to
-     * 4 682 a solve, against 100 without friction). Held as w . x = g_w
-     * instead, the spring's stretch is its multiplier divided by k: the
-     * semismooth Newton step with k -> infinity across the slip, which
-     * changes the step by a relative 1/ratio. A spring is kept where no
-     * dof of w is free to eliminate, or where its rows share dofs with an
-     * active row beyond w's (the row operation would leave the pattern).
+     * adds one large eigenvalue to K = C + sum k w w^T, which AMG on C does
+     * not see, and CG pays for them (the 3D knee's stance at 34 059 dofs:
+     * up to 4 682 iterations a solve, against 100 without friction). Held as w
+     * . x = g_w instead, the spring's stretch is its multiplier divided by k:
+     * the semismooth Newton step with k -> infinity across the slip, which
+     * changes the step by about C/k, at most 1/ratio. A spring is kept where no
+     * dof of w is free to eliminate (or would be, after more than eight
+     * row subtractions). The rows subtracted may bring dofs of their own
+     * (a neighbouring pair's normal row), couplings the matrix pattern
+     * may lack: the hierarchy built on it then misses them, the operator
+     * does not.
      */
     Ties
     tie_stiff(const std::vector<ContactSystem::Spring> &springs,
