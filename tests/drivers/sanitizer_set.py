@@ -79,7 +79,7 @@ def run_one(build, root, name):
     return name, result.returncode
 
 
-def lines_of(build, source, prefix):
+def lines_of(source, prefix):
     """The (file, line, function) triples of source/ that the counts under
     prefix executed: a template's line counts once per instantiation (a
     line run in 2D only is not run in 3D)."""
@@ -150,8 +150,7 @@ def main():
         print("failed in the coverage build:", " ".join(failed))
     with concurrent.futures.ThreadPoolExecutor(2) as pool:
         covered = dict(zip(names, pool.map(
-            lambda name: lines_of(build, source,
-                                  root / name.replace("/", "+")),
+            lambda name: lines_of(source, root / name.replace("/", "+")),
             names)))
     union = set().union(*covered.values())
     times = costs(cost_file)
