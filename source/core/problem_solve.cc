@@ -60,6 +60,7 @@ namespace knee_contact
             coarse_start_time =
               coarse_start(active_set_solver.coarse_start_levels());
           });
+        bool resolved = false;
         timed("mesh", [&]() {
           if (cycle == 0)
             make_mesh(0);
@@ -68,16 +69,27 @@ namespace knee_contact
             make_mesh(cycle);
           else
             {
-              refinement.refine(strategy,
-                                triangulation,
-                                access(),
-                                goal_indicator());
+              resolved = !refinement.refine(strategy,
+                                            triangulation,
+                                            access(),
+                                            goal_indicator());
               check_cells(triangulation);
             }
           scene_checks::check_finite_data(triangulation,
                                           materials,
                                           boundary_conditions);
         });
+        if (resolved)
+          {
+            // The previous cycle's mesh, solution and results stand.
+            std::cout << record.strategy << " cycle " << cycle
+                      << ": the error estimate is round-off (below "
+                      << Refinement::round_off_level
+                      << " of the energy norm): cycle " << cycle - 1
+                      << "'s mesh represents the solution; no more cycles"
+                      << std::endl;
+            break;
+          }
         timed("setup", [&]() { setup_system(); });
         std::cout << record.strategy << " cycle " << cycle << ": "
                   << triangulation.n_active_cells() << " cells, "
