@@ -408,7 +408,7 @@ namespace knee_contact
 
     if (load_cases.values().size() > 1)
       n_failed += run_load_cases(results, sequences, timer);
-    else if (output_writer.enabled())
+    else if (output_writer.takes_part())
       write_result_set(results, sequences, timer);
 
     const auto wall_times =

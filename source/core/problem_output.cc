@@ -23,6 +23,19 @@ namespace knee_contact
     const std::vector<std::vector<CycleRecord>> &sequences,
     TimerOutput                                 &timer)
   {
+    if (!output_writer.enabled())
+      {
+        // Another rank than 0 under mpirun: its pieces of solution.vtu.
+        TimerOutput::Scope scope(timer, "output: vtu");
+        output_writer.write_vtu(dof_handler,
+                                body_of_cell,
+                                displacement,
+                                materials,
+                                contact_pairs,
+                                contact_solution,
+                                results);
+        return;
+      }
     // Declared first: if anything below throws, its destructor waits for
     // the VTU thread before the objects it reads go.
     std::future<void> vtu;
@@ -151,7 +164,7 @@ namespace knee_contact
       records.push_back(std::move(r));
     };
     record(t[0], solver_figures["contact_solve"], first_results);
-    if (output_writer.enabled())
+    if (output_writer.takes_part())
       {
         output_writer.set_subfolder(LoadCases::folder(0));
         write_result_set(first_results, sequences, timer);
@@ -203,7 +216,7 @@ namespace knee_contact
                                        {double(dof_handler.n_dofs())},
                                        std::cout);
         record(t[c], solve_time, results);
-        if (output_writer.enabled())
+        if (output_writer.takes_part())
           {
             output_writer.set_subfolder(LoadCases::folder(c));
             write_result_set(results, {}, timer);

@@ -140,9 +140,13 @@ namespace knee_contact
     if (output_folder.empty())
       output_folder =
         "output/" + std::filesystem::path(scene_file).stem().string();
-    // Every rank holds the results; rank 0 writes them.
+    // Every rank holds the results; rank 0 writes them, the others build
+    // pieces of the VTU for it.
     if (parallel::rank() != 0)
-      write_files = false;
+      {
+        builds_pieces = write_files;
+        write_files   = false;
+      }
     for (const auto &[name, point] : label_entries)
       {
         AssertThrow(!name.empty() && point.size() == dim,

@@ -1,5 +1,6 @@
 // The fields of a result set: solution.vtu (DataOut), the picture data
 // (cells.npy in 2D, surface.npy in 3D) and the contact CSVs.
+#include <knee_contact/base/parallel.h>
 #include <knee_contact/physics/elements.h>
 #include <knee_contact/postprocess/output.h>
 
@@ -8,8 +9,10 @@
 
 #include <algorithm>
 #include <array>
+#include <climits>
 #include <cstdint>
 #include <iomanip>
+#include <sstream>
 
 namespace knee_contact
 {
@@ -271,42 +274,116 @@ namespace knee_contact
     // cells_per_piece, each its own <Piece> of the one file (as deal.II's
     // write_vtu_in_parallel writes a piece per process): the writer's
     // memory is that of one piece.
+    //
+    // Under mpirun every rank holds the solution, and building a piece
+    // (DataOut's patches and zlib) is the output's time: piece i is built
+    // by rank i mod N, which sends its bytes to rank 0, the one that writes
+    // the folder (no shared file system is assumed). The number of pieces
+    // is a multiple of N, so every rank builds as many (7 pieces of
+    // 446 206 cells on two ranks took 5.5 s, 8 pieces 2.1 s); the file is
+    // one solution.vtu, as on one process.
+    const unsigned int ranks = parallel::n_ranks(), rank = parallel::rank();
     const unsigned int n_cells =
       dof_handler.get_triangulation().n_active_cells();
-    std::vector<typename Triangulation<dim>::active_cell_iterator> first;
+    const unsigned int n_pieces =
+      (n_cells + std::size_t(cells_per_piece) * ranks - 1) /
+      (std::size_t(cells_per_piece) * ranks) * ranks;
+    const unsigned int per_piece = (n_cells + n_pieces - 1) / n_pieces;
+    std::vector<typename Triangulation<dim>::active_cell_iterator> first(
+      n_pieces);
+    std::vector<bool> has_cells(n_pieces, false);
     for (const auto &cell : dof_handler.active_cell_iterators())
-      if (cell->active_cell_index() % cells_per_piece == 0)
-        first.push_back(cell);
-    write_file("solution.vtu", [&](std::ostream &out) {
-      DataOutBase::write_vtu_header(out, flags);
-      for (unsigned int piece = 0; piece < first.size(); ++piece)
+      if (cell->active_cell_index() % per_piece == 0)
         {
-          const unsigned int end =
-            std::min<std::size_t>(n_cells,
-                                  std::size_t(piece + 1) * cells_per_piece);
-          using cell_iterator = typename DataOut<dim>::cell_iterator;
-          data_out.set_cell_selection(
-            [&](const Triangulation<dim> &) -> cell_iterator {
-              return first[piece];
-            },
-            [end](const Triangulation<dim> &triangulation,
-                  const cell_iterator      &cell) -> cell_iterator {
-              typename Triangulation<dim>::active_cell_iterator next(cell);
-              ++next;
-              if (next == triangulation.end() ||
-                  next->active_cell_index() >= end)
-                return triangulation.end();
-              return next;
-            });
-          data_out.build_patches(elements::mapping(dof_handler));
-          DataOutBase::write_vtu_main(data_out.get_patches(),
-                                      data_out.dataset_names(),
-                                      data_out.nonscalar_data_ranges(),
-                                      flags,
-                                      out);
+          first[cell->active_cell_index() / per_piece]     = cell;
+          has_cells[cell->active_cell_index() / per_piece] = true;
         }
-      DataOutBase::write_vtu_footer(out);
-    });
+    const auto build = [&](const unsigned int piece, std::ostream &out) {
+      const unsigned int end =
+        std::min<std::size_t>(n_cells, std::size_t(piece + 1) * per_piece);
+      if (!has_cells[piece])
+        return; // more ranks than cells: an empty piece
+      using cell_iterator = typename DataOut<dim>::cell_iterator;
+      data_out.set_cell_selection(
+        [&](const Triangulation<dim> &) -> cell_iterator {
+          return first[piece];
+        },
+        [end](const Triangulation<dim> &triangulation,
+              const cell_iterator      &cell) -> cell_iterator {
+          typename Triangulation<dim>::active_cell_iterator next(cell);
+          ++next;
+          if (next == triangulation.end() || next->active_cell_index() >= end)
+            return triangulation.end();
+          return next;
+        });
+      data_out.build_patches(elements::mapping(dof_handler));
+      DataOutBase::write_vtu_main(data_out.get_patches(),
+                                  data_out.dataset_names(),
+                                  data_out.nonscalar_data_ranges(),
+                                  flags,
+                                  out);
+    };
+    if (rank != 0)
+      {
+        // A helper: its pieces' bytes, one message each (tag: the piece).
+        for (unsigned int piece = rank; piece < n_pieces; piece += ranks)
+          {
+            std::ostringstream bytes;
+            build(piece, bytes);
+            const std::string text = bytes.str();
+            AssertThrow(text.size() < std::size_t(INT_MAX),
+                        ExcMessage("a VTU piece of over 2 GB: lower Output/"
+                                   "Cells per VTU piece"));
+            MPI_Send(text.data(),
+                     int(text.size()),
+                     MPI_CHAR,
+                     0,
+                     int(piece),
+                     parallel::communicator());
+          }
+        return;
+      }
+    // Rank 0: the pieces in order, its own built here, the others'
+    // received. If the file cannot be written, the pieces still to come
+    // are received and dropped, so that no helper waits for ever.
+    unsigned int next = 0;
+    const auto   receive = [&](const unsigned int piece) {
+      MPI_Status status;
+      MPI_Probe(int(piece % ranks), int(piece), parallel::communicator(), &status);
+      int size = 0;
+      MPI_Get_count(&status, MPI_CHAR, &size);
+      std::string text(size, '\0');
+      MPI_Recv(text.data(),
+               size,
+               MPI_CHAR,
+               int(piece % ranks),
+               int(piece),
+               parallel::communicator(),
+               MPI_STATUS_IGNORE);
+      return text;
+    };
+    try
+      {
+        write_file("solution.vtu", [&](std::ostream &out) {
+          DataOutBase::write_vtu_header(out, flags);
+          for (; next < n_pieces; ++next)
+            if (next % ranks == 0)
+              build(next, out);
+            else
+              {
+                const std::string text = receive(next);
+                out.write(text.data(), text.size());
+              }
+          DataOutBase::write_vtu_footer(out);
+        });
+      }
+    catch (...)
+      {
+        for (; next < n_pieces; ++next)
+          if (next % ranks != 0)
+            receive(next);
+        throw;
+      }
   }
 
 

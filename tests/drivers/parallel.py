@@ -6,7 +6,9 @@
    the one-process run: every number of summary.json (energy, reactions,
    forces, pressures, stresses, areas, stick and slip counts, per load
    case too) to 1e-8; the displacement of every vertex (solution.vtu) to
-   1e-8 of max |u|; every contact CSV column to 1e-8 of its largest value,
+   1e-8 of max |u|, its cells, bodies and points equal (the ranks build
+   its pieces, rank 0 writes them); every contact CSV column to 1e-8 of
+   its largest value,
    and its flags (active, stick or slip, the discretisation) equal. The error
    bars (influence solves stopped at a hundredth of their start residual)
    to 1e-2 of the largest bar.
@@ -174,6 +176,20 @@ def read_displacement(path):
         "displacement"))
 
 
+def read_cells(path):
+    """The cells of a solution.vtu (under mpirun built in pieces by every
+    rank and written by rank 0): their number, and the body and
+    coordinates of their vertices (DataOut writes each cell's own
+    vertices), in the file's order."""
+    reader = vtk.vtkXMLUnstructuredGridReader()
+    reader.SetFileName(path)
+    reader.Update()
+    grid = reader.GetOutput()
+    return (grid.GetNumberOfCells(),
+            vtk_to_numpy(grid.GetPointData().GetArray("body_id")).tolist(),
+            vtk_to_numpy(grid.GetPoints().GetData()).tolist())
+
+
 def read_rows(path):
     with open(path) as f:
         return list(csv.DictReader(f))
@@ -188,6 +204,13 @@ def compare_fields(name, one, many, failures):
     if not u1 or u1.keys() != u2.keys():
         failures.append("%s: solution.vtu files %s against %s" %
                         (name, sorted(u1), sorted(u2)))
+    c1 = below(one, "solution.vtu", read_cells)
+    c2 = below(many, "solution.vtu", read_cells)
+    for path in c1:
+        if path in c2 and c1[path] != c2[path]:
+            failures.append("%s: %s: cells, bodies or points differ from the "
+                            "one-process file (%d cells against %d)" %
+                            (name, path, c2[path][0], c1[path][0]))
     u_scale = max([abs(u).max() for u in u1.values()] + [0.0])
     for path in u1:
         if path in u2:

@@ -62,6 +62,13 @@ namespace knee_contact
     void
     commit();
 
+    /**
+     * solution.vtu: displacement, stresses, contact and friction fields at
+     * the vertices, material and body per cell, in pieces of at most
+     * Output/Cells per VTU piece cells. Under mpirun every rank calls it:
+     * piece i is built by rank i mod N and written by rank 0 (at least N
+     * pieces), so the ranks share the output's time.
+     */
     void
     write_vtu(const DoFHandler<dim>           &dof_handler,
               const std::vector<unsigned int> &body_of_cell,
@@ -154,6 +161,18 @@ namespace knee_contact
       return write_files;
     }
 
+    /**
+     * Whether this rank takes part in writing the result sets: rank 0,
+     * which writes them (enabled()), and under mpirun the other ranks,
+     * which build their share of solution.vtu's pieces for it
+     * (write_vtu()).
+     */
+    bool
+    takes_part() const
+    {
+      return write_files || builds_pieces;
+    }
+
   private:
     /** The path of @p name in the staging folder. */
     std::string
@@ -180,6 +199,8 @@ namespace knee_contact
     std::vector<std::pair<std::string, std::vector<double>>> label_entries;
     bool terminal_test = false;
     bool write_files   = true;
+    /** A rank other than 0 of a run that writes files. */
+    bool builds_pieces = false;
   };
 } // namespace knee_contact
 
