@@ -346,10 +346,13 @@ namespace knee_contact
     // Rank 0: the pieces in order, its own built here, the others'
     // received. If the file cannot be written, the pieces still to come
     // are received and dropped, so that no helper waits for ever.
-    unsigned int next = 0;
+    unsigned int next    = 0;
     const auto   receive = [&](const unsigned int piece) {
       MPI_Status status;
-      MPI_Probe(int(piece % ranks), int(piece), parallel::communicator(), &status);
+      MPI_Probe(int(piece % ranks),
+                int(piece),
+                parallel::communicator(),
+                &status);
       int size = 0;
       MPI_Get_count(&status, MPI_CHAR, &size);
       std::string text(size, '\0');

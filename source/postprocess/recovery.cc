@@ -1,6 +1,8 @@
+#include <knee_contact/base/parallel.h>
 #include <knee_contact/physics/elements.h>
 #include <knee_contact/postprocess/recovery.h>
 
+#include <deal.II/base/mpi.h>
 #include <deal.II/base/work_stream.h>
 
 #include <deal.II/fe/fe_values.h>
@@ -93,8 +95,43 @@ namespace knee_contact
     std::vector<types::global_dof_index> cell_dofs(n_cell_dofs);
     std::vector<SymmetricTensor<2, dim>> shape_strains(n_cell_dofs *
                                                        n_vertices);
+    // The (vertex, material) slots and their counts from every cell, in
+    // the cells' order (cheap: no strains).
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      for (unsigned int v = 0; v < n_vertices; ++v)
+        {
+          const unsigned int vertex = cell->vertex_index(v);
+          auto              &here   = recovered[0].averages[vertex];
+          unsigned int       k      = 0;
+          while (k < here.size() && here[k].first != cell->material_id())
+            ++k;
+          if (k == here.size())
+            {
+              for (auto &r : recovered)
+                r.averages[vertex].emplace_back(cell->material_id(),
+                                                SymmetricTensor<2, dim>());
+              counts[vertex].push_back(0);
+            }
+          ++counts[vertex][k];
+          if (any_traction)
+            vertex_of_dof[cell->vertex_dof_index(v, 0)] = vertex;
+        }
+    // The strains summed over this rank's share of the cells (under
+    // mpirun every rank holds the mesh and the solutions: rank r takes the
+    // r-th of N contiguous ranges of active cells), then over the ranks.
+    // Measured at 446 206 cells (2.3e5 dofs, five solutions, two ranks):
+    // 3.0 s on each rank when each summed every cell; with the products
+    // below divided too, the error estimate took 5.6 s instead of 7.7.
+    const unsigned int ranks = parallel::n_ranks(), rank = parallel::rank();
+    const std::size_t  n_cells =
+      dof_handler.get_triangulation().n_active_cells();
+    const std::size_t first = n_cells * rank / ranks,
+                      end   = n_cells * (rank + 1) / ranks;
     for (const auto &cell : dof_handler.active_cell_iterators())
       {
+        if (cell->active_cell_index() < first ||
+            cell->active_cell_index() >= end)
+          continue;
         nodal.reinit(cell);
         cell->get_dof_indices(cell_dofs);
         // The shape functions' strains once per cell, for every solution.
@@ -115,27 +152,31 @@ namespace knee_contact
               }
             for (unsigned int v = 0; v < n_vertices; ++v)
               {
-                const unsigned int vertex = cell->vertex_index(v);
-                auto              &here   = recovered[i].averages[vertex];
-                unsigned int       k      = 0;
-                while (k < here.size() && here[k].first != cell->material_id())
+                auto &here     = recovered[i].averages[cell->vertex_index(v)];
+                unsigned int k = 0;
+                while (here[k].first != cell->material_id())
                   ++k;
-                if (k == here.size())
-                  {
-                    here.emplace_back(cell->material_id(),
-                                      SymmetricTensor<2, dim>());
-                    if (i == 0)
-                      counts[vertex].push_back(0);
-                  }
                 here[k].second += strains[v];
-                if (i == 0)
-                  {
-                    ++counts[vertex][k];
-                    if (any_traction)
-                      vertex_of_dof[cell->vertex_dof_index(v, 0)] = vertex;
-                  }
               }
           }
+      }
+    if (ranks > 1)
+      {
+        constexpr unsigned int n_components =
+          SymmetricTensor<2, dim>::n_independent_components;
+        std::vector<double> sums;
+        for (const auto &r : recovered)
+          for (const auto &slots : r.averages)
+            for (const auto &[id, strain] : slots)
+              for (unsigned int c = 0; c < n_components; ++c)
+                sums.push_back(strain.access_raw_entry(c));
+        Utilities::MPI::sum(sums, parallel::communicator(), sums);
+        std::size_t next = 0;
+        for (auto &r : recovered)
+          for (auto &slots : r.averages)
+            for (auto &[id, strain] : slots)
+              for (unsigned int c = 0; c < n_components; ++c)
+                strain.access_raw_entry(c) = sums[next++];
       }
     for (unsigned int i = 0; i < solutions.size(); ++i)
       {
@@ -231,6 +272,8 @@ namespace knee_contact
 
     struct ProductCopy
     {
+      /** A cell of another rank's share (under mpirun). */
+      bool                skip          = false;
       unsigned int        cell          = 0;
       double              eta_u_squared = 0;
       std::vector<double> products;
@@ -261,11 +304,22 @@ namespace knee_contact
         r.indicators.reinit(dof_handler.get_triangulation().n_active_cells());
 
     // Cell by cell in parallel (WorkStream: the sums in the cells' order,
-    // so the result does not depend on the threads).
+    // so the result does not depend on the threads); under mpirun each
+    // rank sums its share of the cells (as RecoveredStrain::of()), then
+    // the ranks' sums are added.
+    const unsigned int ranks = parallel::n_ranks(), rank = parallel::rank();
+    const std::size_t  n_cells =
+      dof_handler.get_triangulation().n_active_cells();
+    const std::size_t first = n_cells * rank / ranks,
+                      end   = n_cells * (rank + 1) / ranks;
     const auto worker =
       [&](const typename DoFHandler<dim>::active_cell_iterator &cell,
           ProductScratch<dim>                                  &scratch,
           ProductCopy                                          &copy) {
+        copy.skip =
+          cell->active_cell_index() < first || cell->active_cell_index() >= end;
+        if (copy.skip)
+          return;
         FEValues<dim>     &fe_values = scratch.fe_values;
         const unsigned int n_q       = fe_values.n_quadrature_points;
         scratch.cell_dofs.resize(n_cell_dofs);
@@ -333,6 +387,8 @@ namespace knee_contact
           }
       };
     const auto copier = [&](const ProductCopy &copy) {
+      if (copy.skip)
+        return;
       eta_u_squared += copy.eta_u_squared;
       for (unsigned int i = 0; i < n_z; ++i)
         {
@@ -347,6 +403,23 @@ namespace knee_contact
                     copier,
                     ProductScratch<dim>(dof_handler),
                     ProductCopy());
+    if (ranks > 1)
+      {
+        std::vector<double> sums{eta_u_squared};
+        for (const auto &r : result)
+          sums.push_back(r.product);
+        Utilities::MPI::sum(sums, parallel::communicator(), sums);
+        eta_u_squared = sums[0];
+        for (unsigned int i = 0; i < n_z; ++i)
+          result[i].product = sums[1 + i];
+        // Each cell's indicator was set by one rank, zero on the others.
+        if (with_indicators)
+          for (auto &r : result)
+            Utilities::MPI::sum(
+              ArrayView<const float>(r.indicators.begin(), r.indicators.size()),
+              parallel::communicator(),
+              ArrayView<float>(r.indicators.begin(), r.indicators.size()));
+      }
     for (auto &r : result)
       r.eta_u_squared = eta_u_squared;
     return result;
