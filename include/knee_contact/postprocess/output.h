@@ -66,8 +66,8 @@ namespace knee_contact
      * solution.vtu: displacement, stresses, contact and friction fields at
      * the vertices, material and body per cell, in pieces of at most
      * Output/Cells per VTU piece cells. Under mpirun every rank calls it:
-     * piece i is built by rank i mod N and written by rank 0 (at least N
-     * pieces), so the ranks share the output's time.
+     * piece i is built by rank i mod N and written by rank 0 (a multiple
+     * of N pieces), so the ranks share the output's time.
      */
     void
     write_vtu(const DoFHandler<dim>           &dof_handler,
