@@ -23,17 +23,20 @@ namespace knee_contact
     const std::vector<std::vector<CycleRecord>> &sequences,
     TimerOutput                                 &timer)
   {
+    const auto write_vtu = [&]() {
+      TimerOutput::Scope part(timer, "output: vtu");
+      output_writer.write_vtu(dof_handler,
+                              body_of_cell,
+                              displacement,
+                              materials,
+                              contact_pairs,
+                              contact_solution,
+                              results);
+    };
     if (!output_writer.enabled())
       {
         // Another rank than 0 under mpirun: its pieces of solution.vtu.
-        TimerOutput::Scope scope(timer, "output: vtu");
-        output_writer.write_vtu(dof_handler,
-                                body_of_cell,
-                                displacement,
-                                materials,
-                                contact_pairs,
-                                contact_solution,
-                                results);
+        write_vtu();
         return;
       }
     // Declared first: if anything below throws, its destructor waits for
@@ -46,16 +49,7 @@ namespace knee_contact
       // thread while the other files, the summary and the pictures are
       // made, and joined before the folder is committed; everything it
       // reads is read-only by then.
-      vtu = std::async(std::launch::async, [&]() {
-        TimerOutput::Scope part(timer, "output: vtu");
-        output_writer.write_vtu(dof_handler,
-                                body_of_cell,
-                                displacement,
-                                materials,
-                                contact_pairs,
-                                contact_solution,
-                                results);
-      });
+      vtu = std::async(std::launch::async, write_vtu);
       {
         TimerOutput::Scope part(timer,
                                 dim == 2 ? "output: cells.npy"
