@@ -169,7 +169,10 @@ namespace knee_contact
       std::memset(&action, 0, sizeof(action));
       action.sa_handler = handle;
       sigfillset(&action.sa_mask);
-      for (const int signal : {SIGINT, SIGTERM, SIGHUP})
+      // SIGPIPE too: a run whose output goes to a reader that left
+      // (`knee_contact scene.prm | head`) was ended by the default action
+      // and left its staging folder and lock beside the output folder.
+      for (const int signal : {SIGINT, SIGTERM, SIGHUP, SIGPIPE})
         sigaction(signal, &action, nullptr);
     }
 

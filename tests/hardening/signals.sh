@@ -190,6 +190,21 @@ wait $pid || fail "concurrent: the first run failed"
 echo "PASS: a second run on the same folder is refused; the first completes"
 echo "PASS: $n interruptions"
 
+# Standard output to a reader that leaves after the first line
+# (`knee_contact scene.prm | head -n 1`): the run's next line raises
+# SIGPIPE, which must leave nothing behind and the output folder as it was.
+(cd "$folder" && md5sum -- * | sort) >before_pipe.md5
+( "${program[@]}" scene.prm 2>pipe.err; echo $? >pipe.code ) | head -n 1 >/dev/null
+code=$(cat pipe.code)
+[ "$code" -eq 141 ] || fail "SIGPIPE: exit $code, expected 141"
+grep -q "interrupted by a signal; the output folder is unchanged" pipe.err ||
+  fail "SIGPIPE: unexpected message: $(cat pipe.err)"
+[ "$(ls -A | grep -c "^\.out")" -eq 0 ] ||
+  fail "SIGPIPE: staging folder or lock left: $(ls -A)"
+(cd "$folder" && md5sum -- * | sort) | cmp -s - before_pipe.md5 ||
+  fail "SIGPIPE: the output folder changed"
+echo "PASS: SIGPIPE (a reader that left): nothing left, output folder unchanged"
+
 # A rerun after an interface was renamed: the new result set replaces the
 # old one whole, so the old interface's CSV is gone.
 old_csv=$(cd "$folder" && ls contact_*.csv | head -n 1)
