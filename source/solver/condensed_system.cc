@@ -82,9 +82,35 @@ namespace knee_contact
     std::vector<double>                g;
     std::vector<double>                u0;
     std::vector<double>                h;
+    /** Position q of each pair's row in the loop, -1 for none. */
+    std::vector<int> q_of;
+
+    /**
+     * The Coulomb couplings of the following solves, and the lambda_n of
+     * each in the last solve (for the multipliers' residual, and as a
+     * fixed load where the loop's LU fails).
+     */
+    std::vector<ContactSystem::BoundCoupling> couplings;
+    std::vector<double>                       coupling_lambda;
+    /** The multipliers of the last solve. */
+    std::vector<double> last_lambda;
+    /**
+     * Coupled rows outside the loop (the tangential rows in 2D): their
+     * S~^-1 b_r (k each) and B S~^-1 b_r (P each), made on first use.
+     */
+    std::map<unsigned int, unsigned int> outside_of;
+    std::vector<double>                  w_outside, g_outside;
 
     void
     set_up_multiplier_loop();
+
+    /** S~^-1 b_r and B S~^-1 b_r of a coupled row r. */
+    std::pair<const double *, const double *>
+    columns_of(const unsigned int r) const;
+
+    /** Adds the columns of the couplings' rows not yet at hand. */
+    void
+    add_outside_columns();
 
     /** u0 = S~^-1 f and h = B u0 of the current load case. */
     void
@@ -234,10 +260,17 @@ namespace knee_contact
     // out: they are never active, and each row here adds to the P x P
     // system of every iteration.
     row_pairs.clear();
+    outside_of.clear();
+    w_outside.clear();
+    g_outside.clear();
+    q_of.assign(pairs.size(), -1);
     for (unsigned int p = 0; p < pairs.size(); ++p)
       if (pairs[p].eliminated != numbers::invalid_dof_index &&
           (!pairs[p].measured_only || measured_in_loop))
-        row_pairs.push_back(p);
+        {
+          q_of[p] = row_pairs.size();
+          row_pairs.push_back(p);
+        }
     const std::size_t n_rows = row_pairs.size();
     if (k == 0 || n_rows == 0)
       return;
@@ -294,12 +327,87 @@ namespace knee_contact
 
 
 
+  std::pair<const double *, const double *>
+  CondensedContactSystem::Implementation::columns_of(const unsigned int r) const
+  {
+    const std::size_t k = dofs.size(), n_rows = row_pairs.size();
+    if (q_of[r] >= 0)
+      return {&w[q_of[r] * k], &g[q_of[r] * n_rows]};
+    const unsigned int e = outside_of.at(r);
+    return {&w_outside[e * k], &g_outside[e * n_rows]};
+  }
+
+
+
+  void
+  CondensedContactSystem::Implementation::add_outside_columns()
+  {
+    std::vector<unsigned int> added;
+    for (const auto &coupling : couplings)
+      for (const auto &[r, c] : coupling.rows)
+        if (q_of[r] < 0 && outside_of.count(r) == 0)
+          {
+            outside_of[r] = outside_of.size();
+            added.push_back(r);
+          }
+    if (added.empty())
+      return;
+    const std::size_t   k = dofs.size(), n_rows = row_pairs.size();
+    std::vector<double> w_new(k * added.size(), 0.);
+    for (std::size_t e = 0; e < added.size(); ++e)
+      for (const auto &[l, a] : rows[added[e]])
+        w_new[e * k + l] += a;
+    const types::blas_int n = k, n_rhs = added.size();
+    types::blas_int       info = 0;
+    potrs("L", &n, &n_rhs, s_tilde.data(), &n, w_new.data(), &n, &info);
+    AssertThrow(info == 0, ExcInternalError());
+    for (std::size_t e = 0; e < added.size(); ++e)
+      for (std::size_t q = 0; q < n_rows; ++q)
+        {
+          double sum = 0;
+          for (const auto &[l, a] : rows[row_pairs[q]])
+            sum += a * w_new[e * k + l];
+          g_outside.push_back(sum);
+        }
+    w_outside.insert(w_outside.end(), w_new.begin(), w_new.end());
+  }
+
+
+
   bool
   CondensedContactSystem::Implementation::solve_by_multipliers(
     const std::vector<bool> &active)
   {
-    const std::size_t   k = dofs.size(), n_rows = row_pairs.size();
-    std::vector<double> m = g, z(n_rows);
+    const std::size_t k = dofs.size(), n_rows = row_pairs.size();
+    // A coupling's load -lambda_n sum_r c_r b_r, lambda_n = z_n + rho g_n,
+    // changes B x = h - G z into h - rho g_n v - (G z + v z_n) with
+    // v = sum_r c_r B S~^-1 b_r: a column added to G, a change of h; every
+    // row's equation below is then written as before on G' and h'.
+    std::vector<double> g_coupled, h_coupled;
+    if (!couplings.empty())
+      {
+        g_coupled = g;
+        h_coupled = h;
+        for (const auto &coupling : couplings)
+          {
+            const int    q_n = q_of[coupling.normal_row];
+            const double gap = pairs[coupling.normal_row].reduced_gap;
+            AssertThrow(q_n >= 0 && active[coupling.normal_row],
+                        ExcInternalError());
+            for (const auto &[r, c] : coupling.rows)
+              {
+                const double *g_r = columns_of(r).second;
+                for (std::size_t q = 0; q < n_rows; ++q)
+                  {
+                    g_coupled[q_n * n_rows + q] += c * g_r[q];
+                    h_coupled[q] -= rho * gap * c * g_r[q];
+                  }
+              }
+          }
+      }
+    const std::vector<double> &g = couplings.empty() ? this->g : g_coupled;
+    const std::vector<double> &h = couplings.empty() ? this->h : h_coupled;
+    std::vector<double>        m = g, z(n_rows);
     for (std::size_t q = 0; q < n_rows; ++q)
       {
         const unsigned int p = row_pairs[q];
@@ -318,9 +426,6 @@ namespace knee_contact
     // rho cost the LU digits, 1e-9 of the forces on a sliding block).
     if (!springs.empty())
       {
-        std::vector<int> q_of(pairs.size(), -1);
-        for (std::size_t q = 0; q < n_rows; ++q)
-          q_of[row_pairs[q]] = q;
         for (const auto &spring : springs)
           {
             double g_w = 0;
@@ -373,6 +478,18 @@ namespace knee_contact
          &plus_one,
          x_c.data(),
          &one);
+    coupling_lambda.assign(couplings.size(), 0.);
+    for (std::size_t i = 0; i < couplings.size(); ++i)
+      {
+        const unsigned int normal = couplings[i].normal_row;
+        coupling_lambda[i] = z[q_of[normal]] + rho * pairs[normal].reduced_gap;
+        for (const auto &[r, c] : couplings[i].rows)
+          {
+            const double *w_r = columns_of(r).first;
+            for (std::size_t l = 0; l < k; ++l)
+              x_c[l] -= coupling_lambda[i] * c * w_r[l];
+          }
+      }
     return true;
   }
 
@@ -496,6 +613,32 @@ namespace knee_contact
         if (d.multiplier_loop)
           std::vector<double>().swap(d.s);
         d.load_multiplier_loop();
+        if (d.multiplier_loop)
+          d.add_outside_columns();
+        d.timings.loop_setup += clock.wall_time();
+      }
+  }
+
+
+
+  bool
+  CondensedContactSystem::takes_bound_couplings() const
+  {
+    return implementation->multiplier_loop;
+  }
+
+
+
+  void
+  CondensedContactSystem::set_bound_couplings(
+    const std::vector<BoundCoupling> &couplings)
+  {
+    Implementation &d = *implementation;
+    d.couplings       = couplings;
+    if (d.multiplier_loop)
+      {
+        Timer clock;
+        d.add_outside_columns();
         d.timings.loop_setup += clock.wall_time();
       }
   }
@@ -510,12 +653,24 @@ namespace knee_contact
     const std::size_t k = d.dofs.size();
     if (s.empty())
       s = product_with_transpose(l_cc, k, shift);
-    // The springs' k w w^T on S and k g_w w on f, for this solve.
+    // The springs' k w w^T on S and k g_w w on f, for this solve; the
+    // couplings as loads, with the lambda_n of the last solve (this
+    // symmetric path cannot take them implicitly: a fixed-point step).
     std::vector<double> s_saved, f_saved;
-    if (!springs.empty())
+    if (!springs.empty() || !couplings.empty())
       {
         s_saved = s;
         f_saved = f;
+        coupling_lambda.assign(couplings.size(), 0.);
+        for (std::size_t i = 0; i < couplings.size(); ++i)
+          {
+            const unsigned int normal = couplings[i].normal_row;
+            coupling_lambda[i] =
+              last_lambda.empty() ? 0. : std::max(last_lambda[normal], 0.);
+            for (const auto &[r, c] : couplings[i].rows)
+              for (const auto &[l, a] : rows[r])
+                f[l] -= coupling_lambda[i] * c * a;
+          }
         for (const auto &spring : springs)
           {
             const auto [w, g_w] = spring_row(spring);
@@ -607,7 +762,7 @@ namespace knee_contact
         for (const auto &[a, c] : t_of[l])
           d.x_c[l] += c * y[a];
       }
-    if (!springs.empty())
+    if (!springs.empty() || !couplings.empty())
       {
         s.swap(s_saved);
         f.swap(f_saved);
@@ -650,6 +805,11 @@ namespace knee_contact
         for (const auto &[i, a] : w)
           residual(d.dofs[i]) -= spring.stiffness * stretch * a;
       }
+    // Less the couplings' forces lambda_n c_r b_r.
+    for (std::size_t i = 0; i < d.couplings.size(); ++i)
+      for (const auto &[r, c] : d.couplings[i].rows)
+        for (const auto &[l, a] : d.rows[r])
+          residual(d.dofs[l]) -= d.coupling_lambda[i] * c * a;
     lambda = ActiveSetSolver::multipliers(residual,
                                           AffineConstraints<double>(),
                                           d.pairs,
@@ -661,6 +821,7 @@ namespace knee_contact
         for (const auto &[l, a] : d.rows[p])
           excess[p] += a * d.x_c[l];
       }
+    d.last_lambda = lambda;
     d.timings.dense += clock.wall_time();
   }
 

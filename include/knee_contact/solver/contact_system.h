@@ -120,6 +120,42 @@ namespace knee_contact
       AssertThrow(springs.empty(), ExcInternalError());
     }
 
+    /**
+     * The Coulomb bound of a slipping pair taken implicitly: the force
+     * lambda_n sum_r c_r a_r on its tangential rows r (c_r = mu d_r, d the
+     * slip force's direction), lambda_n the multiplier of its active
+     * normal row, solved for with it (the Newton step of
+     * ActiveSetSolver::solve_with_friction() on the bound mu lambda_n; the
+     * system is no longer symmetric).
+     */
+    struct BoundCoupling
+    {
+      unsigned int                                 normal_row = 0;
+      std::vector<std::pair<unsigned int, double>> rows;
+    };
+
+    /**
+     * Whether set_bound_couplings() is served (an unsymmetric solve the
+     * path can do at the cost of a symmetric one); else the loop takes the
+     * bound mu lambda_n from the last solve (a fixed point).
+     */
+    virtual bool
+    takes_bound_couplings() const
+    {
+      return false;
+    }
+
+    /**
+     * The couplings of the following solves (none by default); each
+     * normal_row must be active in them. The multipliers reported are
+     * those of the coupled system.
+     */
+    virtual void
+    set_bound_couplings(const std::vector<BoundCoupling> &couplings)
+    {
+      AssertThrow(couplings.empty(), ExcInternalError());
+    }
+
     /** Whether the last solve met the final tolerance. */
     virtual bool
     last_solve_exact() const
@@ -266,6 +302,17 @@ namespace knee_contact
 
     void
     set_springs(const std::vector<Spring> &springs) override;
+
+    /**
+     * Served by the multiplier loop: a coupling adds a column to its
+     * P x P system (already LU-factorised each iteration), so the Newton
+     * step on the bound costs what the fixed point did.
+     */
+    bool
+    takes_bound_couplings() const override;
+
+    void
+    set_bound_couplings(const std::vector<BoundCoupling> &couplings) override;
 
     void
     solve(const std::vector<bool> &active,
