@@ -201,9 +201,33 @@ namespace knee_contact
     // (Cartesian) and of lambda_n.
     std::map<unsigned int, std::pair<Tensor<1, 3>, double>> needed;
 
-    // The states seen (the active rows and the slip forces), to stop a
-    // cycle.
-    std::set<std::pair<std::vector<bool>, std::vector<TangentialVector>>> seen;
+    // Whether a slipping pair's Coulomb bound is taken by the Newton step
+    // (below): where the path takes it.
+    const auto couples = [&](const unsigned int                   p,
+                             const std::vector<bool>             &state,
+                             const std::vector<TangentialVector> &direction) {
+      if (!system.takes_bound_couplings() || !state[p] || !bounds[p].coulomb ||
+          bounds[p].value <= 0 || magnitude(direction[p]) == 0)
+        return false;
+      for (unsigned int j = 0; j + 1 < dim; ++j)
+        if (rows[at.tangential(j, p)].eliminated == numbers::invalid_dof_index)
+          return false;
+      return true;
+    };
+    // The states seen, to stop a cycle: the active rows and what the solve
+    // takes of each slipping pair, its force, or its direction where the
+    // bound is coupled.
+    using State = std::pair<std::vector<bool>, std::vector<TangentialVector>>;
+    const auto key = [&](const std::vector<bool>             &state,
+                         const std::vector<TangentialVector> &force,
+                         const std::vector<TangentialVector> &direction) {
+      State result{state, force};
+      for (unsigned int p = 0; p < n; ++p)
+        if (couples(p, state, direction))
+          result.second[p] = direction[p];
+      return result;
+    };
+    std::set<State>     seen;
     std::vector<double> excess, lambda;
     Vector<double>      load(rhs.size());
     // Inexact solves while the sets change (the iterative path; the direct
@@ -307,16 +331,9 @@ namespace knee_contact
         // interfaces).
         std::vector<bool>                         coupled(n, false);
         std::vector<ContactSystem::BoundCoupling> couplings;
-        if (system.takes_bound_couplings())
-          for (unsigned int p = 0; p < n; ++p)
+        for (unsigned int p = 0; p < n; ++p)
+          if (couples(p, active, slip_direction))
             {
-              bool rows_held = true;
-              for (unsigned int j = 0; j + 1 < dim; ++j)
-                rows_held = rows_held && rows[at.tangential(j, p)].eliminated !=
-                                           numbers::invalid_dof_index;
-              if (!active[p] || !bounds[p].coulomb || bounds[p].value <= 0 ||
-                  magnitude(slip_direction[p]) == 0 || !rows_held)
-                continue;
               coupled[p] = true;
               ContactSystem::BoundCoupling coupling;
               coupling.normal_row = at.normal(p);
@@ -334,6 +351,8 @@ namespace knee_contact
                 load(dof) -= slip_force[p][j] * a;
         system.set_rhs(load);
         system.set_bound_couplings(couplings);
+        // What this solve depends on, for the cycle test.
+        const auto state = key(active, slip_force, slip_direction);
         system.solve(active, excess, lambda);
         // The force a coupled pair had in this solve.
         for (unsigned int p = 0; p < n; ++p)
@@ -676,7 +695,7 @@ namespace knee_contact
           }
         if (next == active)
           ++result.n_bound_updates;
-        else if (seen.count({next, next_force}))
+        else if (seen.count(key(next, next_force, next_direction)))
           {
             // (A cycle under inexact solves may be the Krylov solver's
             // error: from here on every solve is exact.)
@@ -718,7 +737,7 @@ namespace knee_contact
             next == active
               ? 0.
               : std::clamp(1e-2 * result.complementarity, tolerance, 1e-2));
-        seen.insert({active, slip_force});
+        seen.insert(state);
         active         = next;
         slip_force     = next_force;
         slip_direction = next_direction;
