@@ -567,6 +567,7 @@ namespace knee_contact
                     e[k]                 = 1;
                     ContactRow component = weighted_rows(e);
                     component.gap        = c[k][0] * pair.gap;
+                    component.stick      = true;
                     reduce_row(component, constraints);
                     double largest = 0;
                     for (const auto &[dof, a] : component.reduced_row)

@@ -84,6 +84,11 @@ namespace knee_contact
     std::vector<double>                h;
     /** Position q of each pair's row in the loop, -1 for none. */
     std::vector<int> q_of;
+    /**
+     * Whether loop row q is one of S~'s (else a stick row, in an
+     * iteration's system only while active).
+     */
+    std::vector<bool> in_tilde;
 
     /**
      * The Coulomb couplings of the following solves, and the lambda_n of
@@ -286,24 +291,43 @@ namespace knee_contact
       }
     if (!(s_max > 0 && a_max > 0))
       return;
-    rho     = s_max / a_max;
-    s_tilde = s;
-    for (const unsigned int p : row_pairs)
-      for (const auto &[i, a_i] : rows[p])
-        for (const auto &[j, a_j] : rows[p])
-          s_tilde[std::size_t(j) * k + i] += rho * a_i * a_j;
-    const types::blas_int n    = k;
-    types::blas_int       info = 0;
-    potrf("L", &n, s_tilde.data(), &n, &info);
-    if (info != 0)
-      return;
-    // A pivot at round-off of the largest diagonal entry: S~ is singular in
-    // all but round-off (a body free even with every pair closed); the
-    // elimination path and the rigid-mode diagnostics handle that.
-    double pivot_min = std::numeric_limits<double>::max();
-    for (std::size_t i = 0; i < k; ++i)
-      pivot_min = std::min(pivot_min, s_tilde[i * k + i] * s_tilde[i * k + i]);
-    if (pivot_min < 1e-10 * (s_max + rho * a_max))
+    rho = s_max / a_max;
+    // With friction the stick rows (3 n of the 4 n rows in 2D) stay out of
+    // S~ where S~ is regular without them: an inactive row of S~ is an
+    // unknown of every iteration's system, a stick row outside it only
+    // while it is active (2D knee, 290 pairs, gait path: P = 870 rows
+    // against the 290 normal rows and the few sticking pairs' rows). A body
+    // that only friction holds tangentially needs them in S~.
+    const types::blas_int n         = k;
+    types::blas_int       info      = 0;
+    const auto            factorise = [&](const bool with_stick_rows) {
+      in_tilde.assign(n_rows, false);
+      s_tilde = s;
+      for (std::size_t q = 0; q < n_rows; ++q)
+        if (with_stick_rows || !pairs[row_pairs[q]].stick)
+          {
+            in_tilde[q] = true;
+            for (const auto &[i, a_i] : rows[row_pairs[q]])
+              for (const auto &[j, a_j] : rows[row_pairs[q]])
+                s_tilde[std::size_t(j) * k + i] += rho * a_i * a_j;
+          }
+      potrf("L", &n, s_tilde.data(), &n, &info);
+      if (info != 0)
+        return false;
+      // A pivot at round-off of the largest diagonal entry: S~ is singular
+      // in all but round-off (a body free even with every pair closed);
+      // the elimination path and the rigid-mode diagnostics handle that.
+      double pivot_min = std::numeric_limits<double>::max();
+      for (std::size_t i = 0; i < k; ++i)
+        pivot_min =
+          std::min(pivot_min, s_tilde[i * k + i] * s_tilde[i * k + i]);
+      return pivot_min >= 1e-10 * (s_max + rho * a_max);
+    };
+    const bool has_stick_rows =
+      std::any_of(row_pairs.begin(), row_pairs.end(), [&](const unsigned p) {
+        return pairs[p].stick;
+      });
+    if (!(has_stick_rows && factorise(false)) && !factorise(true))
       return;
 
     w.assign(k * n_rows, 0.);
@@ -407,16 +431,30 @@ namespace knee_contact
       }
     const std::vector<double> &g = couplings.empty() ? this->g : g_coupled;
     const std::vector<double> &h = couplings.empty() ? this->h : h_coupled;
-    std::vector<double>        m = g, z(n_rows);
+    // This iteration's system: the rows of S~ (active or not) and the stick
+    // rows that are active; position of each loop row in it, -1 for none.
+    std::vector<unsigned int> selected;
+    std::vector<int>          at(n_rows, -1);
     for (std::size_t q = 0; q < n_rows; ++q)
+      if (in_tilde[q] || active[row_pairs[q]])
+        {
+          at[q] = selected.size();
+          selected.push_back(q);
+        }
+    const std::size_t   n_system = selected.size();
+    std::vector<double> m(n_system * n_system), z(n_system);
+    for (std::size_t b = 0; b < n_system; ++b)
+      for (std::size_t a = 0; a < n_system; ++a)
+        m[b * n_system + a] = g[selected[b] * n_rows + selected[a]];
+    for (std::size_t a = 0; a < n_system; ++a)
       {
-        const unsigned int p = row_pairs[q];
+        const unsigned int q = selected[a], p = row_pairs[q];
         if (active[p])
-          z[q] = h[q] - pairs[p].reduced_gap;
+          z[a] = h[q] - pairs[p].reduced_gap;
         else
           {
-            z[q] = h[q];
-            m[q * n_rows + q] -= 1. / rho;
+            z[a] = h[q];
+            m[a * n_system + a] -= 1. / rho;
           }
       }
     // A spring k on w = sum_i c_i b_i (rows never active): their z_i must
@@ -424,65 +462,58 @@ namespace knee_contact
     // over its rows, M (G z)_i - z_i / rho = M h_i + k/rho g_w c_i (an
     // inactive row's equation where k = 0, scaled alike: rows scaled by
     // rho cost the LU digits, 1e-9 of the forces on a sliding block).
-    if (!springs.empty())
+    for (const auto &spring : springs)
       {
-        for (const auto &spring : springs)
+        double g_w = 0;
+        for (const auto &[r, c] : spring.rows)
           {
-            double g_w = 0;
-            for (const auto &[r, c] : spring.rows)
+            AssertThrow(q_of[r] >= 0 && at[q_of[r]] >= 0 && !active[r],
+                        ExcInternalError());
+            g_w += c * pairs[r].reduced_gap;
+          }
+        for (const auto &[r_i, c_i] : spring.rows)
+          {
+            const std::size_t a_i = at[q_of[r_i]];
+            for (std::size_t column = 0; column < n_system; ++column)
               {
-                AssertThrow(q_of[r] >= 0 && !active[r], ExcInternalError());
-                g_w += c * pairs[r].reduced_gap;
-              }
-            for (const auto &[r_i, c_i] : spring.rows)
-              {
-                const std::size_t q_i = q_of[r_i];
-                for (std::size_t column = 0; column < n_rows; ++column)
-                  {
-                    double sum = 0;
-                    for (const auto &[r_j, c_j] : spring.rows)
-                      sum += ((r_i == r_j ? 1. : 0.) -
-                              spring.stiffness / rho * c_i * c_j) *
-                             g[column * n_rows + q_of[r_j]];
-                    m[column * n_rows + q_i] = sum;
-                  }
-                m[q_i * n_rows + q_i] -= 1. / rho;
-                double right = spring.stiffness / rho * g_w * c_i;
+                double sum = 0;
                 for (const auto &[r_j, c_j] : spring.rows)
-                  right += ((r_i == r_j ? 1. : 0.) -
-                            spring.stiffness / rho * c_i * c_j) *
-                           h[q_of[r_j]];
-                z[q_i] = right;
+                  sum += ((r_i == r_j ? 1. : 0.) -
+                          spring.stiffness / rho * c_i * c_j) *
+                         g[selected[column] * n_rows + q_of[r_j]];
+                m[column * n_system + a_i] = sum;
               }
+            m[a_i * n_system + a_i] -= 1. / rho;
+            double right = spring.stiffness / rho * g_w * c_i;
+            for (const auto &[r_j, c_j] : spring.rows)
+              right +=
+                ((r_i == r_j ? 1. : 0.) - spring.stiffness / rho * c_i * c_j) *
+                h[q_of[r_j]];
+            z[a_i] = right;
           }
       }
-    const types::blas_int        n = n_rows, one = 1;
+    const types::blas_int        n = n_system, one = 1;
     types::blas_int              info = 0;
-    std::vector<types::blas_int> pivots(n_rows);
+    std::vector<types::blas_int> pivots(n_system);
     getrf(&n, &n, m.data(), &n, pivots.data(), &info);
     if (info != 0)
       return false;
     getrs("N", &n, &one, m.data(), &n, pivots.data(), z.data(), &n, &info);
     AssertThrow(info == 0, ExcInternalError());
-    x_c                          = u0;
-    const types::blas_int rows_k = k, columns = n_rows;
-    const double          minus_one = -1, plus_one = 1;
-    gemv("N",
-         &rows_k,
-         &columns,
-         &minus_one,
-         w.data(),
-         &rows_k,
-         z.data(),
-         &one,
-         &plus_one,
-         x_c.data(),
-         &one);
+    x_c = u0;
+    for (std::size_t a = 0; a < n_system; ++a)
+      {
+        const double *w_q = &w[selected[a] * k];
+        for (std::size_t l = 0; l < k; ++l)
+          x_c[l] -= z[a] * w_q[l];
+      }
     coupling_lambda.assign(couplings.size(), 0.);
     for (std::size_t i = 0; i < couplings.size(); ++i)
       {
         const unsigned int normal = couplings[i].normal_row;
-        coupling_lambda[i] = z[q_of[normal]] + rho * pairs[normal].reduced_gap;
+        AssertThrow(in_tilde[q_of[normal]], ExcInternalError());
+        coupling_lambda[i] =
+          z[at[q_of[normal]]] + rho * pairs[normal].reduced_gap;
         for (const auto &[r, c] : couplings[i].rows)
           {
             const double *w_r = columns_of(r).first;

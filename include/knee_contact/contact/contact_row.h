@@ -70,6 +70,12 @@ namespace knee_contact
      * out of its per-iteration system, and the solver choice counts it.
      */
     bool measured_only = false;
+    /**
+     * A frictional pair's stick row (ContactPairs::stick): active only
+     * while the pair sticks, which on a sliding interface few pairs do.
+     * The condensed path takes it into its per-iteration system only then.
+     */
+    bool stick = false;
 
     /**
      * Whether Gamma_u and Gamma_o alone make the row hold (nothing of it
