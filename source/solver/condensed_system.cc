@@ -256,6 +256,9 @@ namespace knee_contact
     // becomes, with z_A = lambda - rho g_A and z_I = -rho (B_I x),
     //   x = S~^-1 f - W z,  (G - D_I / rho) z = h - g_A,
     // W = S~^-1 B^T, G = B W, h = B S~^-1 f, D_I the inactive diagonal.
+    // A row left out of S~ (a stick row, below) is in an iteration's system
+    // only while active, with z = lambda and the equation of an active row,
+    // (G z)_q = h_q - g_q.
     // S~ and W are made once per mesh (S~ is regular even where S is not:
     // a body held only by contact is held by the rows of all pairs), each
     // iteration solves a P x P system (P = number of pairs, a fraction of
