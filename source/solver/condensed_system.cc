@@ -85,10 +85,17 @@ namespace knee_contact
     /** Position q of each pair's row in the loop, -1 for none. */
     std::vector<int> q_of;
     /**
-     * Whether loop row q is one of S~'s (else a stick row, in an
+     * Whether the stick rows are among S~'s rows (else each is in an
      * iteration's system only while active).
      */
-    std::vector<bool> in_tilde;
+    bool stick_rows_in_tilde = true;
+
+    /** Whether loop row q is one of S~'s. */
+    bool
+    in_tilde(const std::size_t q) const
+    {
+      return stick_rows_in_tilde || !pairs[row_pairs[q]].stick;
+    }
 
     /**
      * The Coulomb couplings of the following solves, and the lambda_n of
@@ -304,12 +311,11 @@ namespace knee_contact
     const types::blas_int n         = k;
     types::blas_int       info      = 0;
     const auto            factorise = [&](const bool with_stick_rows) {
-      in_tilde.assign(n_rows, false);
-      s_tilde = s;
+      stick_rows_in_tilde = with_stick_rows;
+      s_tilde             = s;
       for (std::size_t q = 0; q < n_rows; ++q)
-        if (with_stick_rows || !pairs[row_pairs[q]].stick)
+        if (in_tilde(q))
           {
-            in_tilde[q] = true;
             for (const auto &[i, a_i] : rows[row_pairs[q]])
               for (const auto &[j, a_j] : rows[row_pairs[q]])
                 s_tilde[std::size_t(j) * k + i] += rho * a_i * a_j;
@@ -409,37 +415,42 @@ namespace knee_contact
     // A coupling's load -lambda_n sum_r c_r b_r, lambda_n = z_n + rho g_n,
     // changes B x = h - G z into h - rho g_n v - (G z + v z_n) with
     // v = sum_r c_r B S~^-1 b_r: a column added to G, a change of h; every
-    // row's equation below is then written as before on G' and h'.
-    std::vector<double> g_coupled, h_coupled;
-    if (!couplings.empty())
+    // row's equation below is then written as before on G' and h' (G' is
+    // read through g_of(): only the added columns are stored).
+    std::vector<double>              h = this->h;
+    std::vector<int>                 added_at(n_rows, -1);
+    std::vector<std::vector<double>> added;
+    for (const auto &coupling : couplings)
       {
-        g_coupled = g;
-        h_coupled = h;
-        for (const auto &coupling : couplings)
+        const int    q_n = q_of[coupling.normal_row];
+        const double gap = pairs[coupling.normal_row].reduced_gap;
+        AssertThrow(q_n >= 0 && active[coupling.normal_row] &&
+                      added_at[q_n] < 0,
+                    ExcInternalError());
+        added_at[q_n] = added.size();
+        added.emplace_back(n_rows, 0.);
+        std::vector<double> &v = added.back();
+        for (const auto &[r, c] : coupling.rows)
           {
-            const int    q_n = q_of[coupling.normal_row];
-            const double gap = pairs[coupling.normal_row].reduced_gap;
-            AssertThrow(q_n >= 0 && active[coupling.normal_row],
-                        ExcInternalError());
-            for (const auto &[r, c] : coupling.rows)
-              {
-                const double *g_r = columns_of(r).second;
-                for (std::size_t q = 0; q < n_rows; ++q)
-                  {
-                    g_coupled[q_n * n_rows + q] += c * g_r[q];
-                    h_coupled[q] -= rho * gap * c * g_r[q];
-                  }
-              }
+            const double *g_r = columns_of(r).second;
+            for (std::size_t q = 0; q < n_rows; ++q)
+              v[q] += c * g_r[q];
           }
+        for (std::size_t q = 0; q < n_rows; ++q)
+          h[q] -= rho * gap * v[q];
       }
-    const std::vector<double> &g = couplings.empty() ? this->g : g_coupled;
-    const std::vector<double> &h = couplings.empty() ? this->h : h_coupled;
+    // G'(row, column) of the loop rows.
+    const auto g_of = [&](const std::size_t row, const std::size_t column) {
+      const double entry = g[column * n_rows + row];
+      return added_at[column] < 0 ? entry
+                                  : entry + added[added_at[column]][row];
+    };
     // This iteration's system: the rows of S~ (active or not) and the stick
     // rows that are active; position of each loop row in it, -1 for none.
     std::vector<unsigned int> selected;
     std::vector<int>          at(n_rows, -1);
     for (std::size_t q = 0; q < n_rows; ++q)
-      if (in_tilde[q] || active[row_pairs[q]])
+      if (in_tilde(q) || active[row_pairs[q]])
         {
           at[q] = selected.size();
           selected.push_back(q);
@@ -448,7 +459,7 @@ namespace knee_contact
     std::vector<double> m(n_system * n_system), z(n_system);
     for (std::size_t b = 0; b < n_system; ++b)
       for (std::size_t a = 0; a < n_system; ++a)
-        m[b * n_system + a] = g[selected[b] * n_rows + selected[a]];
+        m[b * n_system + a] = g_of(selected[a], selected[b]);
     for (std::size_t a = 0; a < n_system; ++a)
       {
         const unsigned int q = selected[a], p = row_pairs[q];
@@ -483,7 +494,7 @@ namespace knee_contact
                 for (const auto &[r_j, c_j] : spring.rows)
                   sum += ((r_i == r_j ? 1. : 0.) -
                           spring.stiffness / rho * c_i * c_j) *
-                         g[selected[column] * n_rows + q_of[r_j]];
+                         g_of(q_of[r_j], selected[column]);
                 m[column * n_system + a_i] = sum;
               }
             m[a_i * n_system + a_i] -= 1. / rho;
@@ -514,7 +525,7 @@ namespace knee_contact
     for (std::size_t i = 0; i < couplings.size(); ++i)
       {
         const unsigned int normal = couplings[i].normal_row;
-        AssertThrow(in_tilde[q_of[normal]], ExcInternalError());
+        AssertThrow(in_tilde(q_of[normal]), ExcInternalError());
         coupling_lambda[i] =
           z[at[q_of[normal]]] + rho * pairs[normal].reduced_gap;
         for (const auto &[r, c] : couplings[i].rows)
@@ -545,9 +556,10 @@ namespace knee_contact
   CondensedContactSystem::memory_MB() const
   {
     const Implementation &d = *implementation;
-    const double dense      = (d.l_cc.size() + d.s.size() + d.s_tilde.size() +
-                          d.w.size() + d.g.size()) *
-                         sizeof(double) / 1048576.;
+    const double          dense =
+      (d.l_cc.size() + d.s.size() + d.s_tilde.size() + d.w.size() + d.g.size() +
+       d.w_outside.size() + d.g_outside.size()) *
+      sizeof(double) / 1048576.;
     return {d.cholesky.memory_MB(), dense};
   }
 

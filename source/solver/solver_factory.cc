@@ -223,9 +223,13 @@ namespace knee_contact
     // its factor holds the dense k x k trailing block.
     const double matrix_bytes =
       12. * nnz_lower + 12. * sparsity.n_nonzero_elements();
-    const double sparse_bytes    = 2 * 9.6 * lnz + matrix_bytes;
+    const double sparse_bytes = 2 * 9.6 * lnz + matrix_bytes;
+    // With friction the Newton step on the bound adds, per tangential row,
+    // its columns of W and G where it is not a loop row (2D: k + P) and at
+    // most one coupled column of G per pair (P).
     const double condensed_bytes = 9.6 * (lnz + k * k / 2) + matrix_bytes +
-                                   8. * (3 * k * k + k * P + 2 * P * P);
+                                   8. * (3 * k * k + k * P + 2 * P * P) +
+                                   8. * ((newton ? 0 : k + P) + P) * n_measured;
     // Work [flops]: the condensed path factorises once (the trailing block
     // adds k^3/3), forms S (k^3), factorises S~ (k^3/3), W (2 k^2 P) and per
     // iteration the P x P LU (2/3 P^3).
