@@ -1,6 +1,7 @@
 #include <knee_contact/base/input.h>
 #include <knee_contact/base/progress.h>
 #include <knee_contact/solver/active_set.h>
+#include <knee_contact/solver/row_multipliers.h>
 
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 #include <deal.II/lac/sparse_direct.h>
@@ -154,59 +155,8 @@ namespace knee_contact
     // Equations at the eliminated dofs j_p of the active pairs:
     //   sum_q lambda_q a'_q(j_p) = (C0^T r)(j_p),
     // (C0^T r)(j) = r_j + sum over Gamma_u/Gamma_o lines x_i = c_ij x_j + ..
-    // of c_ij r_i. The matrix is the identity up to scaling unless rows
-    // share eliminated dofs, so this small sparse solve is cheap.
-    std::vector<unsigned int>                   index(pairs.size());
-    std::map<types::global_dof_index, unsigned> equation_of_dof;
-    unsigned int                                n = 0;
-    for (unsigned int p = 0; p < pairs.size(); ++p)
-      if (active[p])
-        {
-          index[p]                             = n;
-          equation_of_dof[pairs[p].eliminated] = n++;
-        }
-    std::vector<double> lambda(pairs.size(), 0.);
-    if (n == 0)
-      return lambda;
-
-    Vector<double> b(n);
-    for (const auto &[dof, e] : equation_of_dof)
-      b(e) = residual(dof);
-    for (const auto &line : base.get_lines())
-      for (const auto &[j, c] : line.entries)
-        {
-          const auto it = equation_of_dof.find(j);
-          if (it != equation_of_dof.end())
-            b(it->second) += c * residual(line.index);
-        }
-
-    DynamicSparsityPattern dsp(n, n);
-    for (unsigned int p = 0; p < pairs.size(); ++p)
-      if (active[p])
-        for (const auto &entry : pairs[p].reduced_row)
-          {
-            const auto it = equation_of_dof.find(entry.first);
-            if (it != equation_of_dof.end())
-              dsp.add(it->second, index[p]);
-          }
-    SparsityPattern sparsity;
-    sparsity.copy_from(dsp);
-    SparseMatrix<double> matrix(sparsity);
-    for (unsigned int p = 0; p < pairs.size(); ++p)
-      if (active[p])
-        for (const auto &[dof, a] : pairs[p].reduced_row)
-          {
-            const auto it = equation_of_dof.find(dof);
-            if (it != equation_of_dof.end())
-              matrix.add(it->second, index[p], a);
-          }
-    SparseDirectUMFPACK solver;
-    solver.initialize(matrix);
-    solver.solve(b);
-    for (unsigned int p = 0; p < pairs.size(); ++p)
-      if (active[p])
-        lambda[p] = b(index[p]);
-    return lambda;
+    // of c_ij r_i (RowMultipliers).
+    return RowMultipliers(base, pairs, active)(residual);
   }
 
 
@@ -339,20 +289,21 @@ namespace knee_contact
 
   void
   ActiveSetSolver::excess_and_multipliers(
-    const SparseMatrix<double>      &matrix,
-    const Vector<double>            &rhs,
-    const Vector<double>            &x,
-    const AffineConstraints<double> &base,
-    const std::vector<ContactRow>   &pairs,
-    const std::vector<bool>         &active,
-    std::vector<double>             &excess,
-    std::vector<double>             &lambda,
-    const std::vector<SpringTerm>   &springs)
+    const SparseMatrix<double>                      &matrix,
+    const Vector<double>                            &rhs,
+    const Vector<double>                            &x,
+    const AffineConstraints<double>                 &base,
+    const std::vector<ContactRow>                   &pairs,
+    const std::vector<bool>                         &active,
+    std::vector<double>                             &excess,
+    std::vector<double>                             &lambda,
+    const std::vector<SpringTerm>                   &springs,
+    const std::vector<ContactSystem::BoundCoupling> &couplings)
   {
     Vector<double> residual(rhs.size());
     matrix.residual(residual, x, rhs);
     springs::add_forces(springs, x, residual);
-    lambda = multipliers(residual, base, pairs, active);
+    lambda = RowMultipliers(base, pairs, active, couplings)(residual);
     excess.resize(pairs.size());
     for (unsigned int p = 0; p < pairs.size(); ++p)
       excess[p] = pairs[p].jump(x) - pairs[p].gap;

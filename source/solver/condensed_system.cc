@@ -104,6 +104,8 @@ namespace knee_contact
      */
     std::vector<ContactSystem::BoundCoupling> couplings;
     std::vector<double>                       coupling_lambda;
+    /** Solves the multiplier loop took with couplings. */
+    unsigned int n_coupled_solves = 0;
     /** The multipliers of the last solve. */
     std::vector<double> last_lambda;
     /**
@@ -522,6 +524,7 @@ namespace knee_contact
           x_c[l] -= z[a] * w_q[l];
       }
     coupling_lambda.assign(couplings.size(), 0.);
+    n_coupled_solves += !couplings.empty();
     for (std::size_t i = 0; i < couplings.size(); ++i)
       {
         const unsigned int normal = couplings[i].normal_row;
@@ -579,7 +582,8 @@ namespace knee_contact
             {"dense_memory_MB", dense_MB},
             {"condensation", t.condensation},
             {"active_set_loop", t.dense},
-            {"expansion", t.expansion}};
+            {"expansion", t.expansion},
+            {"coupled_solves", implementation->n_coupled_solves}};
   }
 
 

@@ -1,6 +1,7 @@
 #include <knee_contact/base/parallel.h>
 #include <knee_contact/solver/active_set.h>
 #include <knee_contact/solver/contact_system.h>
+#include <knee_contact/solver/row_multipliers.h>
 #include <knee_contact/solver/sparse_cholesky.h>
 #include <knee_contact/solver/springs.h>
 
@@ -11,6 +12,7 @@
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 #include <deal.II/lac/solver_cg.h>
 #include <deal.II/lac/solver_control.h>
+#include <deal.II/lac/solver_gmres.h>
 #include <deal.II/lac/sparsity_tools.h>
 #include <deal.II/lac/trilinos_precondition.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
@@ -44,16 +46,19 @@ namespace knee_contact
      * The condensed operator of one active set, T^T C T on the free dofs
      * and C's diagonal on the constrained ones (whose right hand side is
      * zero), applied with the stiffness matrix itself: no copy per set.
+     * With bound couplings T^T (I - B (M + E B)^-1 E) C T (RowMultipliers).
      */
     class CondensedOperator
     {
     public:
       CondensedOperator(const SparseMatrix<double>      &matrix,
                         const AffineConstraints<double> &constraints,
-                        const std::vector<SpringTerm>   &springs)
+                        const std::vector<SpringTerm>   &springs,
+                        const RowMultipliers            &coupling)
         : matrix(matrix)
         , constraints(constraints)
         , springs(springs)
+        , coupling(coupling)
         , spread(matrix.m())
       {}
 
@@ -69,6 +74,7 @@ namespace knee_contact
             for (const auto &[i, a] : spring.w)
               dst(i) += force * a;
           }
+        coupling.project(dst);
         sparse_cholesky::condense_homogeneous(constraints, dst);
         for (const auto &line : constraints.get_lines())
           dst(line.index) = matrix.diag_element(line.index) * src(line.index);
@@ -81,6 +87,7 @@ namespace knee_contact
       const SparseMatrix<double>      &matrix;
       const AffineConstraints<double> &constraints;
       const std::vector<SpringTerm>   &springs;
+      const RowMultipliers            &coupling;
       mutable Vector<double>           spread;
     };
 
@@ -101,9 +108,12 @@ namespace knee_contact
       DistributedCondensedOperator(const TrilinosWrappers::SparseMatrix &matrix,
                                    const AffineConstraints<double> &constraints,
                                    const IndexSet                  &owned,
-                                   const std::vector<SpringTerm>   &springs)
+                                   const std::vector<SpringTerm>   &springs,
+                                   const RowMultipliers            &coupling)
         : matrix(matrix)
         , springs(springs)
+        , coupling(coupling)
+        , owned(owned)
       {
         const MPI_Comm comm = matrix.get_mpi_communicator();
         IndexSet       masters(owned.size());
@@ -197,6 +207,28 @@ namespace knee_contact
               for (const auto &[i, a] : owned_w[k])
                 r[i] += springs[k].stiffness * stretch[k] * a;
           }
+        if (coupling.coupled())
+          {
+            // E r over the owned entries, summed over the ranks; the
+            // (replicated) small solve; -B z on the owned entries.
+            const auto &map   = product.trilinos_vector().Map();
+            const auto  local = [&](const types::global_dof_index i) {
+              return map.LID(TrilinosWrappers::types::int_type(i));
+            };
+            const auto mine = [&](const types::global_dof_index i) {
+              return owned.is_element(i);
+            };
+            const Vector<double> part =
+              coupling.gather(mine, [&](const auto i) { return r[local(i)]; });
+            std::vector<double> sum(part.begin(), part.end());
+            Utilities::MPI::sum(sum, matrix.get_mpi_communicator(), sum);
+            Vector<double> z(sum.begin(), sum.end());
+            coupling.solve(z);
+            coupling.scatter(z, [&](const auto i, const double v) {
+              if (mine(i))
+                r[local(i)] += v;
+            });
+          }
         // T^T r: a constrained row's result goes to its masters, to an
         // owned master in place, to another rank's through to_masters.
         to_masters = 0;
@@ -234,6 +266,8 @@ namespace knee_contact
 
       const TrilinosWrappers::SparseMatrix            &matrix;
       const std::vector<SpringTerm>                   &springs;
+      const RowMultipliers                            &coupling;
+      const IndexSet                                  &owned;
       std::vector<std::vector<std::pair<int, double>>> owned_w;
       /** The constrained dofs of this rank with their masters. */
       std::vector<AffineConstraints<double>::ConstraintLine> lines;
@@ -326,6 +360,10 @@ namespace knee_contact
     /** Those of the current solve left to the operator (the others are
      * tied: springs::tie_stiff()). */
     std::vector<SpringTerm> operator_springs;
+    /** The bound couplings of the following solves, and the current
+     * solve's multipliers with them (its operator's projection). */
+    std::vector<ContactSystem::BoundCoupling> couplings;
+    std::unique_ptr<RowMultipliers>           coupling;
     /** The rows of this rank (all of them on one). */
     IndexSet                       owned;
     AffineConstraints<double>      constraints;
@@ -347,6 +385,8 @@ namespace knee_contact
     /** set_accuracy()'s accuracy is of the start's residual. */
     bool accuracy_of_start = false;
     bool exact             = false;
+    /** Springs the last solve held as rows. */
+    std::size_t n_tied_last = 0;
     /** CG iterations per decade of the residual: after the last set-up,
      * and of the last solve. */
     double rate_at_build = 0, last_decades = 1;
@@ -362,7 +402,8 @@ namespace knee_contact
     {
       double       setup = 0, krylov = 0;
       unsigned int n_setups = 0, n_solves = 0, n_iterations = 0,
-                   max_iterations = 0, n_over_budget = 0, n_tied = 0;
+                   max_iterations = 0, n_over_budget = 0, n_tied = 0,
+                   n_coupled = 0;
     } totals;
 
     void
@@ -377,8 +418,8 @@ namespace knee_contact
     void
     condense_into(TrilinosWrappers::SparseMatrix &condensed_matrix);
 
-    /** CG from @p y on the condensed system with right hand side @p b
-     * (replicated); returns the products taken. */
+    /** CG (GMRES with couplings) from @p y on the condensed system with
+     * right hand side @p b (replicated); returns the products taken. */
     unsigned int
     krylov(Vector<double>       &y,
            const Vector<double> &b,
@@ -591,23 +632,33 @@ namespace knee_contact
       {
         iterative::CondensedOperator operation(matrix,
                                                constraints,
-                                               operator_springs);
+                                               operator_springs,
+                                               *coupling);
         Vector<double>               start_residual(b.size());
         operation.vmult(start_residual, y);
         start_residual.sadd(-1., 1., b);
         set_target(start_residual.l2_norm());
-        SolverCG<Vector<double>> cg(control);
-        cg.solve(operation, y, b, amg);
+        if (coupling->coupled())
+          {
+            SolverGMRES<Vector<double>> gmres(
+              control,
+              SolverGMRES<Vector<double>>::AdditionalData(
+                IterativeContactSystem::gmres_basis, true));
+            gmres.solve(operation, y, b, amg);
+          }
+        else
+          {
+            SolverCG<Vector<double>> cg(control);
+            cg.solve(operation, y, b, amg);
+          }
         return operation.n_products;
       }
 
     // Several ranks: the matrix of this set is never formed.
     if (distributed_matrix.m() != matrix.m())
       copy_rows(matrix, distributed_matrix);
-    const iterative::DistributedCondensedOperator operation(distributed_matrix,
-                                                            constraints,
-                                                            owned,
-                                                            operator_springs);
+    const iterative::DistributedCondensedOperator operation(
+      distributed_matrix, constraints, owned, operator_springs, *coupling);
     const MPI_Comm                comm = parallel::communicator();
     TrilinosWrappers::MPI::Vector y_owned(owned, comm), b_owned(owned, comm),
       start_residual(owned, comm);
@@ -621,8 +672,19 @@ namespace knee_contact
     operation.vmult(start_residual, y_owned);
     start_residual.sadd(-1., 1., b_owned);
     set_target(start_residual.l2_norm());
-    SolverCG<TrilinosWrappers::MPI::Vector> cg(control);
-    cg.solve(operation, y_owned, b_owned, amg);
+    if (coupling->coupled())
+      {
+        SolverGMRES<TrilinosWrappers::MPI::Vector> gmres(
+          control,
+          SolverGMRES<TrilinosWrappers::MPI::Vector>::AdditionalData(
+            IterativeContactSystem::gmres_basis, true));
+        gmres.solve(operation, y_owned, b_owned, amg);
+      }
+    else
+      {
+        SolverCG<TrilinosWrappers::MPI::Vector> cg(control);
+        cg.solve(operation, y_owned, b_owned, amg);
+      }
     // Every rank takes the whole solution (the rows and the results are
     // replicated).
     y = Vector<double>(y_owned);
@@ -686,6 +748,14 @@ namespace knee_contact
 
 
 
+  bool
+  IterativeContactSystem::springs_held_as_rows() const
+  {
+    return implementation->n_tied_last > 0;
+  }
+
+
+
   void
   IterativeContactSystem::solve(const std::vector<bool> &active,
                                 std::vector<double>     &excess,
@@ -718,13 +788,24 @@ namespace knee_contact
       }
     d.operator_springs = std::move(ties.kept);
     d.totals.n_tied += ties.rows.size();
+    d.n_tied_last = ties.rows.size();
     ActiveSetSolver::make_constraints(d.base, *rows, held, d.constraints);
     // The condensed right hand side T^T (d + sum k g_w w - K g), g the
-    // inhomogeneities.
+    // inhomogeneities; with couplings T^T (I - B (M + E B)^-1 E) (...).
+    // (Without couplings no equations: the multipliers are made after the
+    // solve.)
+    d.coupling = std::make_unique<RowMultipliers>(
+      d.base,
+      *rows,
+      d.couplings.empty() ? std::vector<bool>(rows->size(), false) : held,
+      d.couplings);
     const Vector<double> b = springs::condensed_load(d.operator_springs,
                                                      d.matrix,
                                                      *d.rhs,
-                                                     d.constraints);
+                                                     d.constraints,
+                                                     [&](Vector<double> &r) {
+                                                       d.coupling->project(r);
+                                                     });
     d.condensation += clock.wall_time();
 
     // A hierarchy is kept while the CG iterations it costs beyond its rate
@@ -809,7 +890,9 @@ namespace knee_contact
     clock.restart();
     const auto failed = [&](const SolverControl::NoConvergence &failure) {
       std::ostringstream message;
-      message << "the iterative solver (CG with ML's AMG) did not converge "
+      message << "the iterative solver ("
+              << (d.coupling->coupled() ? "GMRES" : "CG")
+              << " with ML's AMG) did not converge "
               << "in " << n_iterations + failure.last_step
               << " iterations (Contact/Krylov iterations): residual "
               << failure.last_residual / b_norm << " of the target "
@@ -873,6 +956,7 @@ namespace knee_contact
     d.totals.max_iterations =
       std::max(d.totals.max_iterations, d.last_iterations);
     ++d.totals.n_solves;
+    d.totals.n_coupled += d.coupling->coupled();
 
     d.x = y;
     d.constraints.distribute(d.x);
@@ -892,8 +976,18 @@ namespace knee_contact
                                             held,
                                             excess,
                                             lambda,
-                                            d.operator_springs);
+                                            d.operator_springs,
+                                            d.couplings);
     springs::untie(ties, d.pairs.size(), excess, lambda);
+  }
+
+
+
+  void
+  IterativeContactSystem::set_bound_couplings(
+    const std::vector<BoundCoupling> &couplings)
+  {
+    implementation->couplings = couplings;
   }
 
 
@@ -965,6 +1059,7 @@ namespace knee_contact
             {"krylov_iterations_max", d.totals.max_iterations},
             {"krylov_over_budget", d.totals.n_over_budget},
             {"tied_springs", d.totals.n_tied},
+            {"coupled_solves", d.totals.n_coupled},
             {"krylov_time", d.totals.krylov},
             {"condensation", d.condensation},
             {"iterative_memory_MB", d.measured_MB},
@@ -974,7 +1069,8 @@ namespace knee_contact
 
 
   double
-  IterativeContactSystem::estimated_bytes(const SparsityPattern &pattern)
+  IterativeContactSystem::estimated_bytes(const SparsityPattern &pattern,
+                                          const bool             friction)
   {
     const double n = pattern.n_rows(), nnz = pattern.n_nonzero_elements();
     // Trilinos' copy of the condensed matrix (values and column indices,
@@ -987,9 +1083,11 @@ namespace knee_contact
     // its condensed rows (8 bytes an entry) and holds its part of Trilinos'
     // condensed matrix (12), of C (12, the operator's) and of the
     // hierarchy (10); the vectors stay whole (replicated).
+    // With friction GMRES's basis: 30 vectors of this rank's rows.
     const double ranks = parallel::n_ranks();
+    const double basis = friction ? 8. * gmres_basis * n / ranks : 0.;
     if (ranks > 1)
-      return 8. * nnz + (12. + 12. + 10.) * nnz / ranks + 8. * 22 * n;
-    return 12. * nnz + 10. * nnz + 8. * 22 * n;
+      return 8. * nnz + (12. + 12. + 10.) * nnz / ranks + 8. * 22 * n + basis;
+    return 12. * nnz + 10. * nnz + 8. * 22 * n + basis;
   }
 } // namespace knee_contact

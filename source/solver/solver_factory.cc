@@ -81,6 +81,17 @@ namespace knee_contact
 
 
 
+  // Whether @p pairs carry friction (measured-only tangential rows).
+  static bool
+  frictional(const std::vector<ContactRow> &pairs)
+  {
+    return std::any_of(pairs.begin(), pairs.end(), [](const ContactRow &row) {
+      return row.measured_only;
+    });
+  }
+
+
+
   // make_contact_system()'s choice, with its name and figures written as it
   // goes (its branches return from several places).
   static std::unique_ptr<ContactSystem>
@@ -124,7 +135,8 @@ namespace knee_contact
       std::string  limit;
       const double available = available_on_every_rank(limit);
       const double bytes =
-        IterativeContactSystem::estimated_bytes(matrix.get_sparsity_pattern());
+        IterativeContactSystem::estimated_bytes(matrix.get_sparsity_pattern(),
+                                                frictional(pairs));
       figures["estimated_iterative_MB"] = bytes / 1048576.;
       figures["available_MB"]           = available / 1048576.;
       AssertThrow(bytes <= 0.8 * available,
@@ -284,7 +296,7 @@ namespace knee_contact
     // 20-25 Gflop/s on the 3D knee (larger supernodes): 10 Gflop/s here.
     const double nnz = sparsity.n_nonzero_elements();
     const double iterative_bytes =
-      IterativeContactSystem::estimated_bytes(sparsity);
+      IterativeContactSystem::estimated_bytes(sparsity, friction);
     // With the Newton step's springs (3D knee, 2.3e5 dofs, mu = 0.04, the
     // four cases of its stance, 2026-11-27): 0.8 set-ups per Newton
     // iteration at about 115 ns per entry, 28 to 40 CG iterations per

@@ -1,5 +1,6 @@
 #include <knee_contact/solver/active_set.h>
 #include <knee_contact/solver/contact_system.h>
+#include <knee_contact/solver/row_multipliers.h>
 #include <knee_contact/solver/sparse_cholesky.h>
 #include <knee_contact/solver/springs.h>
 
@@ -8,6 +9,7 @@
 #include <deal.II/lac/lapack_templates.h>
 #include <deal.II/lac/solver_cg.h>
 #include <deal.II/lac/solver_control.h>
+#include <deal.II/lac/solver_gmres.h>
 
 #include <algorithm>
 #include <cmath>
@@ -171,6 +173,20 @@ namespace knee_contact
     bool
     solve_with_stale_factor(const Vector<double> &b, Vector<double> &y);
 
+    /** The bound couplings of the following solves. */
+    std::vector<ContactSystem::BoundCoupling> couplings;
+    unsigned int n_coupled_solves = 0, coupled_iterations = 0;
+    double       coupled_time = 0;
+
+    /**
+     * The factor's active set with the couplings (GMRES preconditioned by
+     * the factor, from the factor's solution) into x; false if GMRES does
+     * not converge in @p max_iterations.
+     */
+    bool
+    solve_coupled(const RowMultipliers &coupling,
+                  const unsigned int    max_iterations);
+
     Correction
     make_correction(const unsigned int p);
   };
@@ -286,6 +302,77 @@ namespace knee_contact
 
 
 
+  bool
+  SparseContactSystem::Implementation::solve_coupled(
+    const RowMultipliers &coupling,
+    const unsigned int    max_iterations)
+  {
+    // (T^T (I - Q) K T y: y spread, K applied, projected, folded; the
+    // constrained lines stay zero, as the factor keeps them.)
+    struct Operator
+    {
+      const Implementation &d;
+      const RowMultipliers &coupling;
+      void
+      vmult(Vector<double> &dst, const Vector<double> &src) const
+      {
+        Vector<double> spread = src;
+        sparse_cholesky::distribute_homogeneous(d.constraints, spread);
+        d.vmult(dst, spread);
+        coupling.project(dst);
+        sparse_cholesky::condense_homogeneous(d.constraints, dst);
+      }
+    };
+    struct Preconditioner
+    {
+      sparse_cholesky::SparseCholesky &cholesky;
+      void
+      vmult(Vector<double> &dst, const Vector<double> &src) const
+      {
+        std::vector<double> z(src.begin(), src.end());
+        cholesky.solve(CHOLMOD_A, z);
+        std::copy(z.begin(), z.end(), dst.begin());
+      }
+    };
+    Timer      clock;
+    const auto b =
+      springs::condensed_load(springs,
+                              matrix,
+                              *rhs,
+                              constraints,
+                              [&](Vector<double> &r) { coupling.project(r); });
+    Vector<double> y(b.size());
+    Preconditioner{cholesky}.vmult(y, b);
+    SolverControl               control(max_iterations,
+                          1e-12 * std::max(b.l2_norm(), 1e-300),
+                          false,
+                          false);
+    SolverGMRES<Vector<double>> gmres(
+      control,
+      SolverGMRES<Vector<double>>::AdditionalData(
+        IterativeContactSystem::gmres_basis, true));
+    bool converged = true;
+    try
+      {
+        gmres.solve(Operator{*this, coupling}, y, b, Preconditioner{cholesky});
+      }
+    catch (const SolverControl::NoConvergence &)
+      {
+        converged = false;
+      }
+    coupled_iterations += control.last_step();
+    coupled_time += clock.wall_time();
+    if (!converged)
+      return false;
+    x = y;
+    constraints.distribute(x);
+    ++n_coupled_solves;
+    n_stale_factor_solves += !springs::same_matrix(springs, factor_springs);
+    return true;
+  }
+
+
+
   SparseContactSystem::Implementation::Correction
   SparseContactSystem::Implementation::make_correction(const unsigned int p)
   {
@@ -386,6 +473,15 @@ namespace knee_contact
 
 
   void
+  SparseContactSystem::set_bound_couplings(
+    const std::vector<BoundCoupling> &couplings)
+  {
+    implementation->couplings = couplings;
+  }
+
+
+
+  void
   SparseContactSystem::gaps_changed()
   {
     Implementation &d = *implementation;
@@ -442,6 +538,44 @@ namespace knee_contact
     const auto stale = [&]() {
       return !springs::same_matrix(d.springs, d.factor_springs);
     };
+    if (!d.couplings.empty())
+      {
+        // The coupled system: on a factor of this very set (its springs
+        // may be older: the factor only preconditions).
+        if (!d.has_factor || active != d.base_active)
+          d.factorise(active);
+        const RowMultipliers coupling(d.base, d.pairs, active, d.couplings);
+        Timer                clock;
+        // Within what half a factorisation costs (as with stale springs
+        // alone), else on a factor of the springs set now.
+        const double per_iteration =
+          16 * d.cholesky.nnz_factor() + 2. * d.matrix.n_nonzero_elements();
+        const unsigned int budget = static_cast<unsigned int>(
+          std::max(5., 0.5 * d.cholesky.flops() / per_iteration));
+        if (!d.solve_coupled(coupling, budget))
+          {
+            if (stale())
+              d.factorise(active);
+            AssertThrow(d.solve_coupled(coupling, 1000),
+                        ExcMessage("the sparse path's GMRES on the coupled "
+                                   "Coulomb bound did not converge in 1000 "
+                                   "iterations"));
+          }
+        // (The next uncoupled solve makes its base solution anew.)
+        d.base_solved = false;
+        ActiveSetSolver::excess_and_multipliers(d.matrix,
+                                                *d.rhs,
+                                                d.x,
+                                                d.base,
+                                                d.pairs,
+                                                active,
+                                                excess,
+                                                lambda,
+                                                d.springs,
+                                                d.couplings);
+        d.solves += clock.wall_time();
+        return;
+      }
     if (!d.has_factor || (n_new + 1) * correction_flops > d.cholesky.flops() ||
         (d.corrections.size() + n_new) * vector_MB >
           std::max(d.cholesky.memory_MB(), 8 * vector_MB) ||
@@ -652,6 +786,9 @@ namespace knee_contact
             {"spring_sets", d.n_spring_sets},
             {"stale_factor_solves", d.n_stale_factor_solves},
             {"stale_factor_cg_iterations", d.stale_factor_iterations},
-            {"stale_factor_time", d.stale_factor_time}};
+            {"stale_factor_time", d.stale_factor_time},
+            {"coupled_solves", d.n_coupled_solves},
+            {"coupled_gmres_iterations", d.coupled_iterations},
+            {"coupled_time", d.coupled_time}};
   }
 } // namespace knee_contact

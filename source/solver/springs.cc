@@ -90,17 +90,26 @@ namespace knee_contact
 
 
     Vector<double>
-    condensed_load(const std::vector<SpringTerm>   &springs,
-                   const SparseMatrix<double>      &matrix,
-                   const Vector<double>            &rhs,
-                   const AffineConstraints<double> &constraints)
+    condensed_load(const std::vector<SpringTerm>               &springs,
+                   const SparseMatrix<double>                  &matrix,
+                   const Vector<double>                        &rhs,
+                   const AffineConstraints<double>             &constraints,
+                   const std::function<void(Vector<double> &)> &before_folding)
     {
-      if (springs.empty())
+      if (springs.empty() && !before_folding)
         return sparse_cholesky::condense(matrix, rhs, constraints);
       Vector<double> g(rhs.size()), load = rhs;
       constraints.distribute(g);
       add_forces(springs, g, load);
-      return sparse_cholesky::condense(matrix, load, constraints);
+      if (!before_folding)
+        return sparse_cholesky::condense(matrix, load, constraints);
+      // (distribute() gave g on the constrained dofs: the masters are
+      // free, zero.)
+      Vector<double> b(rhs.size());
+      matrix.residual(b, g, load);
+      before_folding(b);
+      sparse_cholesky::condense_homogeneous(constraints, b);
+      return b;
     }
 
 

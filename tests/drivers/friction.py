@@ -428,18 +428,54 @@ def main():
                     interface=INTERFACE.format(pairing=pairing, mu=mu),
                     folder=os.path.join(folder, name))
                 if factor < 1:
-                    summary = run(binary, text, folder, name)
-                    interface = summary["contact_interfaces"]["block"]
-                    total = [interface["force_on_slave"][d] +
-                             interface["tangential_force_on_slave"][d] +
-                             (F, -G)[d] for d in range(2)]
-                    error = max(abs(x) for x in total) / G
-                    print("CGS-4 %s, F/G = %.4f (threshold %.4f): interface "
-                          "force + load relative %.1e (tolerance 1e-8); %d "
-                          "sticking, %d slipping" %
-                          (pairing, F / G, threshold, error,
-                           interface["n_stick"], interface["n_slip"]))
-                    failures += error > 1e-8
+                    # On every solver path: step-41's takes the Coulomb
+                    # bound mu lambda_n of the last solve (a fixed point),
+                    # the others the Newton step, each in its own algebra
+                    # (the condensed path's dense multiplier system, GMRES
+                    # on the sparse factor and on AMG): they must agree,
+                    # and the Newton step must not take more iterations.
+                    found = {}
+                    for solver in ("step-41", "condensed", "sparse",
+                                   "iterative"):
+                        text = INCLINED.format(
+                            geo=geo, fx=F, fy=-G, materials=MATERIALS,
+                            interface=INTERFACE.format(pairing=pairing,
+                                                       mu=mu),
+                            folder=os.path.join(folder, name + solver))
+                        summary = run(binary, text.replace(
+                            "subsection Contact\n",
+                            "subsection Contact\n  set Solver = %s\n"
+                            % solver, 1), folder, name + solver)
+                        found[solver] = summary
+                        interface = summary["contact_interfaces"]["block"]
+                        total = [interface["force_on_slave"][d] +
+                                 interface["tangential_force_on_slave"][d] +
+                                 (F, -G)[d] for d in range(2)]
+                        error = max(abs(x) for x in total) / G
+                        print("CGS-4 %s, F/G = %.4f (threshold %.4f), %s: "
+                              "interface force + load relative %.1e "
+                              "(tolerance 1e-8); %d sticking, %d slipping, "
+                              "%d iterations" %
+                              (pairing, F / G, threshold, solver, error,
+                               interface["n_stick"], interface["n_slip"],
+                               summary["active_set_iterations"]))
+                        failures += error > 1e-8
+                    for solver in ("condensed", "sparse", "iterative"):
+                        difference = max(
+                            abs(found[solver][key] - found["step-41"][key]) /
+                            abs(found["step-41"][key])
+                            for key in ("energy", "max_displacement"))
+                        coupled = found[solver]["solver"]["coupled_solves"]
+                        print("  %s against step-41: energy and max |u| "
+                              "%.1e (tolerance 1e-8), %d iterations against "
+                              "%d, %g coupled solves (must be > 0)"
+                              % (solver, difference,
+                                 found[solver]["active_set_iterations"],
+                                 found["step-41"]["active_set_iterations"],
+                                 coupled))
+                        failures += difference > 1e-8 or coupled == 0 or \
+                            found[solver]["active_set_iterations"] > \
+                            found["step-41"]["active_set_iterations"]
                 else:
                     ratio = (F * math.cos(a) - G * math.sin(a)) / (
                         F * math.sin(a) + G * math.cos(a))

@@ -8,6 +8,7 @@
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/vector.h>
 
+#include <functional>
 #include <utility>
 #include <vector>
 
@@ -70,13 +71,18 @@ namespace knee_contact
     /**
      * The condensed load of K x = d + sum k g_w w under @p constraints:
      * T^T (d + sum k g_w w - K g), g the constraints' inhomogeneities
-     * (sparse_cholesky::condense() with the springs' forces at g).
+     * (sparse_cholesky::condense() with the springs' forces at g);
+     * @p before_folding, if given, changes the whole vector
+     * d + sum k g_w w - K g before T^T folds it (the bound couplings'
+     * projection, RowMultipliers::project()).
      */
     Vector<double>
-    condensed_load(const std::vector<SpringTerm>   &springs,
-                   const SparseMatrix<double>      &matrix,
-                   const Vector<double>            &rhs,
-                   const AffineConstraints<double> &constraints);
+    condensed_load(
+      const std::vector<SpringTerm>               &springs,
+      const SparseMatrix<double>                  &matrix,
+      const Vector<double>                        &rhs,
+      const AffineConstraints<double>             &constraints,
+      const std::function<void(Vector<double> &)> &before_folding = {});
 
     /**
      * The springs of @p springs (on_dofs() of @p rows' springs) stiff
