@@ -214,17 +214,16 @@ namespace knee_contact
     // (a refined mesh's or load case's contact zone), up to 17 cold
     // (scripts/benchmark.py); each costs the condensed path one P x P LU.
     // With friction the stick and slip sets and the Coulomb bounds settle
-    // too: measured 9-17 cold on the sagittal knee (mu = 0.04 and 0.3),
-    // 4-9 along a load path.
+    // too; every path takes the Newton step on the bound
+    // (ContactSystem::set_bound_couplings()): measured 8-15 cold on the
+    // sagittal knee (mu = 0.3 and 0.04, condensed and sparse alike), at
+    // most 5 per case along the gait path, 10-12 per case on the 3D knee's
+    // stance (34 059 dofs). The iterative path's inexact solves took 17
+    // cold and 9-12 along that stance at 1.25e5 dofs.
     const double iterations =
-      friction ? (warm_start ? 7 : 15) : (warm_start ? 3 : 10);
-    // The condensed path takes the Newton step on the Coulomb bound
-    // (ContactSystem::set_bound_couplings()), the sparse one its fixed
-    // point: measured about half the iterations (sagittal knee, mu = 0.3:
-    // 8 against 15; the gait path, mu = 0.04: 59 against 115 in 21 cases;
-    // the tibial tray's path, mu = 0.5: 132 against 259).
-    const double condensed_iterations =
-      friction ? (warm_start ? 4 : 10) : iterations;
+      friction ? (warm_start ? 4 : 10) : (warm_start ? 3 : 10);
+    const double iterative_iterations =
+      friction ? (warm_start ? 12 : 17) : iterations;
 
     // Peak memory beyond what is allocated now [bytes]: the factor's values
     // and indices (about 1.2 x 8 bytes per entry measured), CHOLMOD's copy of
@@ -253,21 +252,21 @@ namespace knee_contact
     // (1.35e5 dofs, AMD EPYC, 2026-11-24), so its flops count an eighth.
     const double condensed_flops =
       fl + 0.25 * (k * k * k * (1. / 3 + 1 + 1. / 3) + 2 * k * k * P) +
-      0.125 * condensed_iterations * 2. / 3 * P * P * P;
+      0.125 * iterations * 2. / 3 * P * P * P;
     // The sparse path refactorises only when an active set differs from its
     // factor's in more rows than a factorisation's worth of solves: from a
     // guess one factorisation and a few solves (measured 1.1-1.3
     // factorisations), cold about two per three iterations (knee, 1.1e5
     // dofs: 9 factorisations and 31 update solves in 14 iterations).
-    // With friction about one per two iterations (knee, 1.35e5 dofs, mu =
-    // 0.04: 6 factorisations and 7 bordered updates, 20 update solves, in
-    // 13 iterations).
-    // With the Newton step's springs, which change at every iteration,
-    // about 0.7 per iteration: a set that stays is solved by CG on the
-    // last factor (3D knee, 1.25e5 dofs, mu = 0.04, four load cases: 37
-    // factorisations and 15 such solves in 52 iterations).
+    // With friction one per iteration: a coupled solve (the Newton step
+    // on the bound) takes a factor of its own set, no bordered update
+    // (sagittal knee, mu = 0.04: 15 in 15 iterations).
+    // With the 3D Newton step's springs, which change at every iteration,
+    // about 0.7 per iteration: a set that stays is solved by GMRES on the
+    // last factor (3D knee's stance, 34 059 dofs, mu = 0.04: 32
+    // factorisations in 44 iterations).
     const double sparse_flops = (newton       ? 0.7 * iterations
-                                 : friction   ? 0.5 * iterations
+                                 : friction   ? 1.0 * iterations
                                  : warm_start ? 1.3
                                               : 0.65 * iterations) *
                                 fl;
@@ -301,8 +300,9 @@ namespace knee_contact
     // four cases of its stance, 2026-11-27): 0.8 set-ups per Newton
     // iteration at about 115 ns per entry, 28 to 40 CG iterations per
     // Newton iteration.
-    const double krylov_iterations = (newton ? 40 : 30) * iterations + 150;
-    const double setup_ns          = newton ? 115 * 0.8 * iterations : 75;
+    const double krylov_iterations =
+      (newton ? 40 : 30) * iterative_iterations + 150;
+    const double setup_ns = newton ? 115 * 0.8 * iterative_iterations : 75;
     // Several ranks share the iterative path's work (the direct paths run
     // whole on each).
     const double iterative_seconds =
