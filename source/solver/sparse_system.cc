@@ -165,27 +165,36 @@ namespace knee_contact
     solve_base_homogeneous(Vector<double> &b);
 
     /**
-     * Solve the factor's system with the springs set now (T^T K T y = b
-     * on the factor's active set), CG preconditioned by the factor of the
-     * springs it was made with, from @p y; false if CG does not reach the
-     * factorisation's accuracy within what a factorisation would cost.
+     * Solve the factor's active set with the springs set now,
+     * T^T K T y = b, or with @p coupling its Coulomb couplings too,
+     * T^T (I - B (M + E B)^-1 E) K T y = b (RowMultipliers): CG (GMRES)
+     * preconditioned by the factor, from @p y, to 1e-12 of b; false if it
+     * does not converge in @p max_iterations.
      */
     bool
-    solve_with_stale_factor(const Vector<double> &b, Vector<double> &y);
+    solve_on_factor(const Vector<double> &b,
+                    Vector<double>       &y,
+                    const RowMultipliers *coupling,
+                    const unsigned int    max_iterations);
+
+    /**
+     * The Krylov iterations half a factorisation costs: each about one
+     * correction's solve (16 nnz(L) flops at the factorisation's rate,
+     * measured: see solve()) and a product with K.
+     */
+    unsigned int
+    krylov_budget() const
+    {
+      const double per_iteration =
+        16 * cholesky.nnz_factor() + 2. * matrix.n_nonzero_elements();
+      return static_cast<unsigned int>(
+        std::max(5., 0.5 * cholesky.flops() / per_iteration));
+    }
 
     /** The bound couplings of the following solves. */
     std::vector<ContactSystem::BoundCoupling> couplings;
     unsigned int n_coupled_solves = 0, coupled_iterations = 0;
     double       coupled_time = 0;
-
-    /**
-     * The factor's active set with the couplings (GMRES preconditioned by
-     * the factor, from the factor's solution) into x; false if GMRES does
-     * not converge in @p max_iterations.
-     */
-    bool
-    solve_coupled(const RowMultipliers &coupling,
-                  const unsigned int    max_iterations);
 
     Correction
     make_correction(const unsigned int p);
@@ -235,28 +244,36 @@ namespace knee_contact
 
 
   bool
-  SparseContactSystem::Implementation::solve_with_stale_factor(
+  SparseContactSystem::Implementation::solve_on_factor(
     const Vector<double> &b,
-    Vector<double>       &y)
+    Vector<double>       &y,
+    const RowMultipliers *coupling,
+    const unsigned int    max_iterations)
   {
     // Why: the semismooth Newton step of 3D friction sets new spring
     // stiffnesses at every iteration while the active set mostly stays (a
     // slipping pair is active by its normal row alone). K differs from the
     // factor's matrix by the change of the springs, sum dk w w^T, so the
     // factor is a preconditioner that CG needs few iterations with; a
-    // factorisation costs as much as hundreds of its solves in 3D.
-    // (T^T K T y: y spread over the constrained lines, K applied, the
-    // constrained lines folded back; they stay zero, as the factor keeps
-    // them.)
+    // factorisation costs as much as hundreds of its solves in 3D. The
+    // Newton step on the Coulomb bound changes T^T K T by the couplings'
+    // low-rank term only: GMRES on the factor of the set takes 5 to 11
+    // iterations a solve (3D and 2D knees).
+    // (T^T (I - Q) K T y: y spread over the constrained lines, K applied,
+    // projected, the constrained lines folded back; they stay zero, as the
+    // factor keeps them.)
     struct Operator
     {
       const Implementation &d;
+      const RowMultipliers *coupling;
       void
       vmult(Vector<double> &dst, const Vector<double> &src) const
       {
         Vector<double> spread = src;
         sparse_cholesky::distribute_homogeneous(d.constraints, spread);
         d.vmult(dst, spread);
+        if (coupling != nullptr)
+          coupling->project(dst);
         sparse_cholesky::condense_homogeneous(d.constraints, dst);
       }
     };
@@ -271,104 +288,45 @@ namespace knee_contact
         std::copy(z.begin(), z.end(), dst.begin());
       }
     };
-    // A CG iteration costs about one correction's solve (16 nnz(L) flops
-    // at the factorisation's rate, measured: see solve()) and a product
-    // with K; give up when half a factorisation is spent.
-    const double per_iteration =
-      16 * cholesky.nnz_factor() + 2. * matrix.n_nonzero_elements();
-    const unsigned int max_iterations = static_cast<unsigned int>(
-      std::max(5., 0.5 * cholesky.flops() / per_iteration));
     Timer          clock;
     SolverControl  control(max_iterations,
                           1e-12 * std::max(b.l2_norm(), 1e-300),
                           false,
                           false);
-    SolverCG<>     cg(control);
-    const Operator operation{*this};
+    const Operator operation{*this, coupling};
     bool           converged = true;
     try
       {
-        cg.solve(operation, y, b, Preconditioner{cholesky});
+        if (coupling != nullptr)
+          SolverGMRES<Vector<double>>(
+            control,
+            SolverGMRES<Vector<double>>::AdditionalData(
+              IterativeContactSystem::gmres_basis, true))
+            .solve(operation, y, b, Preconditioner{cholesky});
+        else
+          SolverCG<Vector<double>>(control).solve(operation,
+                                                  y,
+                                                  b,
+                                                  Preconditioner{cholesky});
       }
     catch (const SolverControl::NoConvergence &)
       {
         converged = false;
       }
-    stale_factor_time += clock.wall_time();
-    stale_factor_iterations += control.last_step();
-    n_stale_factor_solves += converged;
+    const bool stale = !springs::same_matrix(springs, factor_springs);
+    if (coupling != nullptr)
+      {
+        coupled_time += clock.wall_time();
+        coupled_iterations += control.last_step();
+        n_coupled_solves += converged;
+      }
+    else
+      {
+        stale_factor_time += clock.wall_time();
+        stale_factor_iterations += control.last_step();
+      }
+    n_stale_factor_solves += converged && stale;
     return converged;
-  }
-
-
-
-  bool
-  SparseContactSystem::Implementation::solve_coupled(
-    const RowMultipliers &coupling,
-    const unsigned int    max_iterations)
-  {
-    // (T^T (I - Q) K T y: y spread, K applied, projected, folded; the
-    // constrained lines stay zero, as the factor keeps them.)
-    struct Operator
-    {
-      const Implementation &d;
-      const RowMultipliers &coupling;
-      void
-      vmult(Vector<double> &dst, const Vector<double> &src) const
-      {
-        Vector<double> spread = src;
-        sparse_cholesky::distribute_homogeneous(d.constraints, spread);
-        d.vmult(dst, spread);
-        coupling.project(dst);
-        sparse_cholesky::condense_homogeneous(d.constraints, dst);
-      }
-    };
-    struct Preconditioner
-    {
-      sparse_cholesky::SparseCholesky &cholesky;
-      void
-      vmult(Vector<double> &dst, const Vector<double> &src) const
-      {
-        std::vector<double> z(src.begin(), src.end());
-        cholesky.solve(CHOLMOD_A, z);
-        std::copy(z.begin(), z.end(), dst.begin());
-      }
-    };
-    Timer      clock;
-    const auto b =
-      springs::condensed_load(springs,
-                              matrix,
-                              *rhs,
-                              constraints,
-                              [&](Vector<double> &r) { coupling.project(r); });
-    Vector<double> y(b.size());
-    Preconditioner{cholesky}.vmult(y, b);
-    SolverControl               control(max_iterations,
-                          1e-12 * std::max(b.l2_norm(), 1e-300),
-                          false,
-                          false);
-    SolverGMRES<Vector<double>> gmres(
-      control,
-      SolverGMRES<Vector<double>>::AdditionalData(
-        IterativeContactSystem::gmres_basis, true));
-    bool converged = true;
-    try
-      {
-        gmres.solve(Operator{*this, coupling}, y, b, Preconditioner{cholesky});
-      }
-    catch (const SolverControl::NoConvergence &)
-      {
-        converged = false;
-      }
-    coupled_iterations += control.last_step();
-    coupled_time += clock.wall_time();
-    if (!converged)
-      return false;
-    x = y;
-    constraints.distribute(x);
-    ++n_coupled_solves;
-    n_stale_factor_solves += !springs::same_matrix(springs, factor_springs);
-    return true;
   }
 
 
@@ -533,7 +491,7 @@ namespace knee_contact
     const double correction_flops = 16 * d.cholesky.nnz_factor();
     const double vector_MB        = 8. * d.matrix.m() / 1048576.;
     // With other springs than the factor's, only the factor's own active
-    // set is solved on it (by CG, solve_with_stale_factor()); the bordered
+    // set is solved on it (by CG, solve_on_factor()); the bordered
     // update needs exact solves.
     const auto stale = [&]() {
       return !springs::same_matrix(d.springs, d.factor_springs);
@@ -546,21 +504,32 @@ namespace knee_contact
           d.factorise(active);
         const RowMultipliers coupling(d.base, d.pairs, active, d.couplings);
         Timer                clock;
-        // Within what half a factorisation costs (as with stale springs
-        // alone), else on a factor of the springs set now.
-        const double per_iteration =
-          16 * d.cholesky.nnz_factor() + 2. * d.matrix.n_nonzero_elements();
-        const unsigned int budget = static_cast<unsigned int>(
-          std::max(5., 0.5 * d.cholesky.flops() / per_iteration));
-        if (!d.solve_coupled(coupling, budget))
+        const auto           b = springs::condensed_load(
+          d.springs, d.matrix, *d.rhs, d.constraints, [&](Vector<double> &r) {
+            coupling.project(r);
+          });
+        // From the factor's solution; within what half a factorisation
+        // costs (as with stale springs alone), else on a factor of the
+        // springs set now.
+        Vector<double> y(b.size());
+        const auto     start = [&]() {
+          std::vector<double> z(b.begin(), b.end());
+          d.cholesky.solve(CHOLMOD_A, z);
+          std::copy(z.begin(), z.end(), y.begin());
+        };
+        start();
+        if (!d.solve_on_factor(b, y, &coupling, d.krylov_budget()))
           {
             if (stale())
               d.factorise(active);
-            AssertThrow(d.solve_coupled(coupling, 1000),
+            start();
+            AssertThrow(d.solve_on_factor(b, y, &coupling, 1000),
                         ExcMessage("the sparse path's GMRES on the coupled "
                                    "Coulomb bound did not converge in 1000 "
                                    "iterations"));
           }
+        d.x = y;
+        d.constraints.distribute(d.x);
         // (The next uncoupled solve makes its base solution anew.)
         d.base_solved = false;
         ActiveSetSolver::excess_and_multipliers(d.matrix,
@@ -602,7 +571,7 @@ namespace knee_contact
               for (const auto &line : d.constraints.get_lines())
                 y(line.index) = 0;
             }
-          solved = d.solve_with_stale_factor(b, y);
+          solved = d.solve_on_factor(b, y, nullptr, d.krylov_budget());
           if (solved)
             d.x0 = y;
           else
