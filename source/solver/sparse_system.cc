@@ -496,6 +496,22 @@ namespace knee_contact
     const auto stale = [&]() {
       return !springs::same_matrix(d.springs, d.factor_springs);
     };
+    // The multipliers (those of the coupled system with couplings) and
+    // the excess of the solution.
+    const auto report = [&]() {
+      Timer clock;
+      ActiveSetSolver::excess_and_multipliers(d.matrix,
+                                              *d.rhs,
+                                              d.x,
+                                              d.base,
+                                              d.pairs,
+                                              active,
+                                              excess,
+                                              lambda,
+                                              d.springs,
+                                              d.couplings);
+      d.solves += clock.wall_time();
+    };
     if (!d.couplings.empty())
       {
         // The coupled system: on a factor of this very set (its springs
@@ -532,17 +548,8 @@ namespace knee_contact
         d.constraints.distribute(d.x);
         // (The next uncoupled solve makes its base solution anew.)
         d.base_solved = false;
-        ActiveSetSolver::excess_and_multipliers(d.matrix,
-                                                *d.rhs,
-                                                d.x,
-                                                d.base,
-                                                d.pairs,
-                                                active,
-                                                excess,
-                                                lambda,
-                                                d.springs,
-                                                d.couplings);
         d.solves += clock.wall_time();
+        report();
         return;
       }
     if (!d.has_factor || (n_new + 1) * correction_flops > d.cholesky.flops() ||
@@ -689,17 +696,7 @@ namespace knee_contact
         ++d.n_updates_on_factor;
       }
 
-    clock.restart();
-    ActiveSetSolver::excess_and_multipliers(d.matrix,
-                                            *d.rhs,
-                                            d.x,
-                                            d.base,
-                                            d.pairs,
-                                            active,
-                                            excess,
-                                            lambda,
-                                            d.springs);
-    d.solves += clock.wall_time();
+    report();
   }
 
 
