@@ -4,7 +4,6 @@
 #include <knee_contact/solver/row_multipliers.h>
 
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
-#include <deal.II/lac/sparse_direct.h>
 #include <deal.II/lac/sparsity_pattern.h>
 
 #include <deal.II/dofs/dof_tools.h>

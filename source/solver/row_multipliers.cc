@@ -32,20 +32,12 @@ namespace knee_contact
         if (const auto it = equation_of_dof.find(j);
             it != equation_of_dof.end())
           e_entries.push_back({line.index, it->second, c});
-    // E of a full vector given by its entries, as (equation, value).
+    // E's entries by dof (E of B's columns below).
     std::multimap<types::global_dof_index, std::pair<unsigned int, double>>
       e_of_dof;
     for (const Entry &entry : e_entries)
       e_of_dof.emplace(entry.dof,
                        std::make_pair(entry.equation, entry.coefficient));
-    const auto e_of = [&](const auto &entries, const auto &add) {
-      for (const auto &[dof, a] : entries)
-        {
-          const auto [first, last] = e_of_dof.equal_range(dof);
-          for (auto it = first; it != last; ++it)
-            add(it->second.first, it->second.second * a);
-        }
-    };
 
     // B's columns on the full tangential rows.
     for (const auto &coupling : couplings)
@@ -73,12 +65,12 @@ namespace knee_contact
               it != equation_of_dof.end())
             values.push_back({{it->second, equation_of_row[p]}, a});
     for (const Entry &entry : b_entries)
-      e_of(
-        std::vector<std::pair<types::global_dof_index, double>>{
-          {entry.dof, entry.coefficient}},
-        [&](const unsigned int e, const double v) {
-          values.push_back({{e, entry.equation}, v});
-        });
+      {
+        const auto [first, last] = e_of_dof.equal_range(entry.dof);
+        for (auto it = first; it != last; ++it)
+          values.push_back({{it->second.first, entry.equation},
+                            it->second.second * entry.coefficient});
+      }
     for (const auto &[at, value] : values)
       dsp.add(at.first, at.second);
     sparsity.copy_from(dsp);
@@ -150,18 +142,5 @@ namespace knee_contact
   {
     for (const Entry &entry : b_entries)
       add(entry.dof, -entry.coefficient * z(entry.equation));
-  }
-
-
-
-  std::vector<types::global_dof_index>
-  RowMultipliers::touched_dofs() const
-  {
-    std::vector<types::global_dof_index> dofs;
-    for (const Entry &entry : e_entries)
-      dofs.push_back(entry.dof);
-    for (const Entry &entry : b_entries)
-      dofs.push_back(entry.dof);
-    return dofs;
   }
 } // namespace knee_contact

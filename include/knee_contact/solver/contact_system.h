@@ -552,8 +552,7 @@ namespace knee_contact
      * A coupling enters the operator as the projection of RowMultipliers
      * (T^T (I - B (M + E B)^-1 E) C T, applied, never formed: one small
      * sparse solve per product, summed over the ranks), and the solve
-     * takes GMRES (gmres_basis) with the same
-     * hierarchy.
+     * takes GMRES (gmres_basis) with the same hierarchy.
      */
     bool
     takes_bound_couplings() const override

@@ -82,10 +82,6 @@ namespace knee_contact
       const Vector<double>                                       &z,
       const std::function<void(types::global_dof_index, double)> &add) const;
 
-    /** The dofs project() reads and writes (a rank's ghosts). */
-    std::vector<types::global_dof_index>
-    touched_dofs() const;
-
   private:
     /** t_q += coefficient r_i: (i, q, coefficient). */
     struct Entry
