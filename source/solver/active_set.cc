@@ -288,21 +288,22 @@ namespace knee_contact
 
   void
   ActiveSetSolver::excess_and_multipliers(
-    const SparseMatrix<double>                      &matrix,
-    const Vector<double>                            &rhs,
-    const Vector<double>                            &x,
-    const AffineConstraints<double>                 &base,
-    const std::vector<ContactRow>                   &pairs,
-    const std::vector<bool>                         &active,
-    std::vector<double>                             &excess,
-    std::vector<double>                             &lambda,
-    const std::vector<SpringTerm>                   &springs,
-    const std::vector<ContactSystem::BoundCoupling> &couplings)
+    const SparseMatrix<double>      &matrix,
+    const Vector<double>            &rhs,
+    const Vector<double>            &x,
+    const AffineConstraints<double> &base,
+    const std::vector<ContactRow>   &pairs,
+    const std::vector<bool>         &active,
+    std::vector<double>             &excess,
+    std::vector<double>             &lambda,
+    const std::vector<SpringTerm>   &springs,
+    const RowMultipliers            *coupled)
   {
     Vector<double> residual(rhs.size());
     matrix.residual(residual, x, rhs);
     springs::add_forces(springs, x, residual);
-    lambda = RowMultipliers(base, pairs, active, couplings)(residual);
+    lambda = coupled != nullptr ? (*coupled)(residual)
+                                : RowMultipliers(base, pairs, active)(residual);
     excess.resize(pairs.size());
     for (unsigned int p = 0; p < pairs.size(); ++p)
       excess[p] = pairs[p].jump(x) - pairs[p].gap;

@@ -977,7 +977,9 @@ namespace knee_contact
                                             excess,
                                             lambda,
                                             d.operator_springs,
-                                            d.couplings);
+                                            d.couplings.empty()
+                                              ? nullptr
+                                              : d.coupling.get());
     springs::untie(ties, d.pairs.size(), excess, lambda);
   }
 

@@ -498,7 +498,7 @@ namespace knee_contact
     };
     // The multipliers (those of the coupled system with couplings) and
     // the excess of the solution.
-    const auto report = [&]() {
+    const auto report = [&](const RowMultipliers *coupled) {
       Timer clock;
       ActiveSetSolver::excess_and_multipliers(d.matrix,
                                               *d.rhs,
@@ -509,7 +509,7 @@ namespace knee_contact
                                               excess,
                                               lambda,
                                               d.springs,
-                                              d.couplings);
+                                              coupled);
       d.solves += clock.wall_time();
     };
     if (!d.couplings.empty())
@@ -549,7 +549,7 @@ namespace knee_contact
         // (The next uncoupled solve makes its base solution anew.)
         d.base_solved = false;
         d.solves += clock.wall_time();
-        report();
+        report(&coupling);
         return;
       }
     if (!d.has_factor || (n_new + 1) * correction_flops > d.cholesky.flops() ||
@@ -696,7 +696,7 @@ namespace knee_contact
         ++d.n_updates_on_factor;
       }
 
-    report();
+    report(nullptr);
   }
 
 

@@ -4,6 +4,7 @@
 #include <knee_contact/contact/contact_row.h>
 #include <knee_contact/physics/rigid_modes.h>
 #include <knee_contact/solver/contact_system.h>
+#include <knee_contact/solver/row_multipliers.h>
 #include <knee_contact/solver/springs.h>
 
 #include <deal.II/base/parameter_handler.h>
@@ -281,21 +282,20 @@ namespace knee_contact
      * What a path that solves for the whole x reports (step-41, sparse):
      * the multipliers from the residual d - C x (multipliers()), less the
      * forces of the @p springs set, and the excess (A x - g)_p of every
-     * pair from its jump; with @p couplings those of the coupled system
-     * (RowMultipliers).
+     * pair from its jump; with @p coupled those of the coupled system
+     * (the RowMultipliers the solve made, not made twice).
      */
     static void
-    excess_and_multipliers(
-      const SparseMatrix<double>                      &matrix,
-      const Vector<double>                            &rhs,
-      const Vector<double>                            &x,
-      const AffineConstraints<double>                 &base,
-      const std::vector<ContactRow>                   &pairs,
-      const std::vector<bool>                         &active,
-      std::vector<double>                             &excess,
-      std::vector<double>                             &lambda,
-      const std::vector<SpringTerm>                   &springs   = {},
-      const std::vector<ContactSystem::BoundCoupling> &couplings = {});
+    excess_and_multipliers(const SparseMatrix<double>      &matrix,
+                           const Vector<double>            &rhs,
+                           const Vector<double>            &x,
+                           const AffineConstraints<double> &base,
+                           const std::vector<ContactRow>   &pairs,
+                           const std::vector<bool>         &active,
+                           std::vector<double>             &excess,
+                           std::vector<double>             &lambda,
+                           const std::vector<SpringTerm>   &springs = {},
+                           const RowMultipliers            *coupled = nullptr);
 
     /**
      * max |x_i| over the contact unknowns (every free dof of a row that
