@@ -380,6 +380,13 @@ namespace knee_contact
      * springs eliminated. */
     std::vector<bool>                    amg_active;
     std::vector<types::global_dof_index> amg_tied;
+    /** Whether amg_matrix holds a condensed matrix, and its rows that
+     * depend on its set (condense()). */
+    bool amg_filled = false;
+    /** This rank's part of the near null space (ML reads it again when it
+     * recomputes a hierarchy). */
+    std::vector<double>                  modes;
+    std::vector<types::global_dof_index> amg_set_rows;
     Vector<double>                       x;
     double                               accuracy = 0;
     /** set_accuracy()'s accuracy is of the start's residual. */
@@ -401,22 +408,28 @@ namespace knee_contact
     struct Totals
     {
       double       setup = 0, krylov = 0;
-      unsigned int n_setups = 0, n_solves = 0, n_iterations = 0,
-                   max_iterations = 0, n_over_budget = 0, n_tied = 0,
-                   n_coupled = 0;
+      unsigned int n_setups = 0, n_recomputed = 0, n_solves = 0,
+                   n_iterations = 0, max_iterations = 0, n_over_budget = 0,
+                   n_tied = 0, n_coupled = 0;
     } totals;
 
+    /** A hierarchy for the current set: ML's recomputation on the
+     * current one's aggregates, or with @p anew (or none yet) a new one. */
     void
-    build_amg();
+    build_amg(const bool anew = false);
 
-    /** This rank's rows of @p from (the stiffness matrix's pattern). */
+    /** The @p rows of @p from (the stiffness matrix's pattern, this
+     * rank's rows) into @p to, which holds this rank's rows (made on the
+     * first call). */
     void
-    copy_rows(const SparseMatrix<double>     &from,
-              TrilinosWrappers::SparseMatrix &to);
+    copy_rows(const SparseMatrix<double>                 &from,
+              TrilinosWrappers::SparseMatrix             &to,
+              const std::vector<types::global_dof_index> &rows);
 
-    /** The condensed matrix of the current set, this rank's rows. */
+    /** amg_matrix: the condensed matrix of the current set, this rank's
+     * rows. */
     void
-    condense_into(TrilinosWrappers::SparseMatrix &condensed_matrix);
+    condense();
 
     /** CG (GMRES with couplings) from @p y on the condensed system with
      * right hand side @p b (replicated); returns the products taken. */
@@ -434,20 +447,38 @@ namespace knee_contact
 
 
   void
-  IterativeContactSystem::Implementation::build_amg()
+  IterativeContactSystem::Implementation::build_amg(const bool anew)
   {
     Timer clock;
-    // The old hierarchy and matrix go first: kept while the new ones were
-    // made, a rebuild (and the benchmark's reference solve) held two
-    // hierarchies, about 10 bytes per matrix entry more than the
-    // estimate's 22.
+    // Another set's hierarchy is recomputed on its aggregates (ML's
+    // ReComputePreconditioner: the same aggregates and null space, the new
+    // matrix's Galerkin products and smoothers; the matrix is refilled in
+    // place, as ML asks). Measured on the 3D knee's stance with friction at
+    // 1.25e5 dofs (2026-11-28): 0.2 s against 0.4 s for ML's part of a
+    // set-up, and fewer Krylov iterations in all than with new aggregates
+    // at every set-up: the first case's contact solve 16.7 s against 32.5,
+    // the further cases' 36.1 against 80.9 (new aggregates every 4th
+    // set-up: 23.3 and 52.4). A hierarchy over its budget is made anew.
+    if (has_amg && !anew)
+      {
+        condense();
+        dynamic_cast<ML_Epetra::MultiLevelPreconditioner &>(
+          amg.trilinos_operator())
+          .ReComputePreconditioner();
+        ++totals.n_setups;
+        ++totals.n_recomputed;
+        totals.setup += clock.wall_time();
+        return;
+      }
+    // The old hierarchy goes first: kept while the new one was made, a
+    // rebuild (and the benchmark's reference solve) held two hierarchies,
+    // about 10 bytes per matrix entry more than the estimate.
     amg.clear();
-    amg_matrix.clear();
-    condense_into(amg_matrix);
+    condense();
     // This rank's part of the null space, zero on the constrained dofs:
     // their rows are decoupled.
     const types::global_dof_index n = matrix.m(), n_local = owned.n_elements();
-    std::vector<double>           modes(n_modes * n_local);
+    modes.assign(n_modes * n_local, 0.);
     for (unsigned int k = 0; k < n_modes; ++k)
       {
         types::global_dof_index local = 0;
@@ -500,68 +531,145 @@ namespace knee_contact
 
 
   void
-  IterativeContactSystem::Implementation::condense_into(
-    TrilinosWrappers::SparseMatrix &condensed_matrix)
+  IterativeContactSystem::Implementation::condense()
   {
-    if (parallel::n_ranks() == 1)
+    // This rank's rows of T^T C T (C's diagonal on the constrained lines,
+    // as CondensedOperator), which deal.II does not offer in this form
+    // (AffineConstraints::condense takes the whole matrix: on the 3D knee
+    // at 2.3e5 dofs its copy and condensation on every rank made two ranks
+    // slower than one; on one rank its copy, condensation and Trilinos's
+    // copy took 0.5 of a 0.9 s set-up at 1.25e5 dofs, 35 set-ups in a
+    // frictional run). Row i receives C's row i with each constrained
+    // column spread over its masters, and every constrained row l with
+    // master i, weighted (the constraints are closed: masters are free).
+    // Summed on the pattern, which holds every set's condensed system
+    // (ActiveSetSolver::make_sparsity_pattern).
+    //
+    // Only the rows a set changes are made again: those of its lines that
+    // are not the base's (the contact rows and the tied springs), the
+    // rows with such a line's dof as a column (C is symmetric: the line's
+    // row's columns), its masters, and the masters of constrained rows
+    // among these. The last set's rows are made again too (to drop what
+    // it added); every other row is the base's condensation, the same for
+    // every set.
+    const types::global_dof_index n = matrix.m();
+    std::vector<bool>             of_set(n, false);
+    const auto                    mark = [&](const types::global_dof_index i) {
+      of_set[i] = true;
+    };
+    for (const auto &line : constraints.get_lines())
       {
-        // deal.II condenses (on the pattern that holds every set),
-        // Trilinos takes a copy, the deal.II one goes.
-        SparseMatrix<double> condensed(matrix.get_sparsity_pattern());
-        condensed.copy_from(matrix);
-        constraints.condense(condensed);
-        condensed_matrix.reinit(condensed, 0., true);
-        return;
+        const auto *in_base = base.get_constraint_entries(line.index);
+        if (in_base != nullptr && *in_base == line.entries)
+          continue;
+        mark(line.index);
+        for (const auto &[master, weight] : line.entries)
+          mark(master);
+        for (auto entry = matrix.begin(line.index);
+             entry != matrix.end(line.index);
+             ++entry)
+          mark(entry->column());
       }
+    for (const auto &line : constraints.get_lines())
+      if (of_set[line.index])
+        for (const auto &[master, weight] : line.entries)
+          mark(master);
 
-    // Several ranks: only this rank's rows of T^T C T (C's diagonal on the
-    // constrained lines, as CondensedOperator), which deal.II does not
-    // offer (AffineConstraints::condense takes the whole matrix: on the 3D
-    // knee at 2.3e5 dofs its copy and condensation on every rank made two
-    // ranks slower than one). Row i receives C's row i with each
-    // constrained column spread over its masters, and every constrained
-    // row l with master i, weighted (the constraints are closed: masters
-    // are free). Summed on the pattern, which holds every set's condensed
-    // system (ActiveSetSolver::make_sparsity_pattern).
+    std::vector<bool> remake(n, !amg_filled);
+    if (amg_filled)
+      {
+        for (const auto i : amg_set_rows)
+          remake[i] = true;
+        for (types::global_dof_index i = 0; i < n; ++i)
+          remake[i] = remake[i] || of_set[i];
+      }
+    std::vector<types::global_dof_index> rows;
+    amg_set_rows.clear();
+    for (const auto row : owned)
+      {
+        if (remake[row])
+          rows.push_back(row);
+        if (of_set[row])
+          amg_set_rows.push_back(row);
+      }
+    for (types::global_dof_index i = 0; i < n; ++i)
+      remake[i] = remake[i] && owned.is_element(i);
+
     if (row_sums.empty())
       row_sums.reinit(matrix.get_sparsity_pattern());
-    for (const auto row : owned)
+    for (const auto row : rows)
       for (auto entry = row_sums.begin(row); entry != row_sums.end(row);
            ++entry)
         entry->value() = 0;
-    // Spread C's row @p from, times @p weight, into row @p to.
-    const auto spread = [&](const types::global_dof_index from,
-                            const types::global_dof_index to,
-                            const double                  weight) {
+    // C's row @p from with its constrained columns spread over their
+    // masters, once per row (a contact row has tens of masters, and
+    // spreading it for each one took 0.5 s a set-up at 1.25e5 dofs).
+    std::vector<double>                  row_of(n, 0.);
+    std::vector<bool>                    in_row(n, false);
+    std::vector<types::global_dof_index> columns;
+    const auto spread = [&](const types::global_dof_index from) {
+      columns.clear();
+      const auto add = [&](const types::global_dof_index j, const double v) {
+        if (!in_row[j])
+          columns.push_back(j);
+        in_row[j] = true;
+        row_of[j] += v;
+      };
       for (auto entry = matrix.begin(from); entry != matrix.end(from); ++entry)
+        if (const auto *masters =
+              constraints.get_constraint_entries(entry->column()))
+          for (const auto &[master, w] : *masters)
+            add(master, w * entry->value());
+        else
+          add(entry->column(), entry->value());
+    };
+    // Adds @p weight times the spread row to row @p to.
+    const auto add_to = [&](const types::global_dof_index to,
+                            const double                  weight) {
+      for (const auto j : columns)
+        row_sums.add(to, j, weight * row_of[j]);
+    };
+    const auto clear = [&]() {
+      for (const auto j : columns)
         {
-          const auto column = entry->column();
-          if (const auto *masters = constraints.get_constraint_entries(column))
-            for (const auto &[master, w] : *masters)
-              row_sums.add(to, master, weight * w * entry->value());
-          else if (!constraints.is_constrained(column))
-            row_sums.add(to, column, weight * entry->value());
+          row_of[j] = 0;
+          in_row[j] = false;
         }
     };
-    for (const auto row : owned)
+    for (const auto row : rows)
       if (constraints.is_constrained(row))
         row_sums.set(row, row, matrix.diag_element(row));
       else
-        spread(row, row, 1.);
+        {
+          spread(row);
+          add_to(row, 1.);
+          clear();
+        }
     for (const auto &line : constraints.get_lines())
-      for (const auto &[master, weight] : line.entries)
-        if (owned.is_element(master))
-          spread(line.index, master, weight);
-
-    copy_rows(row_sums, condensed_matrix);
+      {
+        bool spread_yet = false;
+        for (const auto &[master, weight] : line.entries)
+          if (remake[master])
+            {
+              if (!spread_yet)
+                spread(line.index);
+              spread_yet = true;
+              add_to(master, weight);
+            }
+        if (spread_yet)
+          clear();
+      }
+    copy_rows(row_sums, amg_matrix, rows);
+    amg_filled = true;
   }
 
 
 
   void
   IterativeContactSystem::Implementation::copy_rows(
-    const SparseMatrix<double>     &from,
-    TrilinosWrappers::SparseMatrix &to)
+    const SparseMatrix<double>                 &from,
+    TrilinosWrappers::SparseMatrix             &to,
+    const std::vector<types::global_dof_index> &rows)
   {
     const SparsityPattern &pattern = from.get_sparsity_pattern();
     if (trilinos_pattern.n_rows() != pattern.n_rows())
@@ -573,10 +681,11 @@ namespace knee_contact
             trilinos_pattern.add(row, entry->column());
         trilinos_pattern.compress();
       }
-    to.reinit(trilinos_pattern);
+    if (to.m() != pattern.n_rows())
+      to.reinit(trilinos_pattern);
     std::vector<types::global_dof_index> columns;
     std::vector<double>                  values;
-    for (const auto row : owned)
+    for (const auto row : rows)
       {
         columns.clear();
         values.clear();
@@ -656,7 +765,10 @@ namespace knee_contact
 
     // Several ranks: the matrix of this set is never formed.
     if (distributed_matrix.m() != matrix.m())
-      copy_rows(matrix, distributed_matrix);
+      copy_rows(matrix,
+                distributed_matrix,
+                std::vector<types::global_dof_index>(owned.begin(),
+                                                     owned.end()));
     const iterative::DistributedCondensedOperator operation(
       distributed_matrix, constraints, owned, operator_springs, *coupling);
     const MPI_Comm                comm = parallel::communicator();
@@ -925,7 +1037,7 @@ namespace knee_contact
         n_iterations = failure.last_step;
         n_products   = failure.last_step + 1;
         Timer rebuild;
-        d.build_amg();
+        d.build_amg(/*anew=*/true);
         d.amg_active = active;
         d.amg_tied   = tied;
         fresh        = true;
@@ -1055,6 +1167,7 @@ namespace knee_contact
   {
     const Implementation &d = *implementation;
     return {{"amg_setups", d.totals.n_setups},
+            {"amg_recomputed", d.totals.n_recomputed},
             {"amg_setup", d.totals.setup},
             {"krylov_solves", d.totals.n_solves},
             {"krylov_iterations", d.totals.n_iterations},
@@ -1075,21 +1188,18 @@ namespace knee_contact
                                           const bool             friction)
   {
     const double n = pattern.n_rows(), nnz = pattern.n_nonzero_elements();
-    // Trilinos' copy of the condensed matrix (values and column indices,
-    // 12 bytes an entry), beside it first the deal.II condensed values
-    // (8 bytes an entry, freed), then the hierarchy (about 10 bytes per
-    // fine entry measured with plain aggregation: 150 MB for the knee's
-    // 1.48e7 entries); the null space twice (ML's copy), the CG and operator
-    // vectors and the condensed right hand side: about 22 vectors.
-    // Several ranks: each keeps a deal.II matrix on the whole pattern for
-    // its condensed rows (8 bytes an entry) and holds its part of Trilinos'
-    // condensed matrix (12), of C (12, the operator's) and of the
-    // hierarchy (10); the vectors stay whole (replicated).
-    // With friction GMRES's basis: 30 vectors of this rank's rows.
+    // A deal.II matrix on the whole pattern for the condensed rows it
+    // makes (8 bytes an entry, condense()), Trilinos' copy of this rank's
+    // condensed rows (values and column indices, 12 bytes an entry), the
+    // hierarchy (about 10 bytes per fine entry measured with plain
+    // aggregation: 150 MB for the knee's 1.48e7 entries); the null space
+    // twice (ML's copy), the CG and operator vectors and the condensed
+    // right hand side: about 22 vectors. Several ranks: each also holds its
+    // part of C in Trilinos (12, the operator's); the vectors stay whole
+    // (replicated). With friction GMRES's basis of this rank's rows.
     const double ranks = parallel::n_ranks();
     const double basis = friction ? 8. * gmres_basis * n / ranks : 0.;
-    if (ranks > 1)
-      return 8. * nnz + (12. + 12. + 10.) * nnz / ranks + 8. * 22 * n + basis;
-    return 12. * nnz + 10. * nnz + 8. * 22 * n + basis;
+    const double of_c  = ranks > 1 ? 12. : 0.;
+    return 8. * nnz + (12. + 10. + of_c) * nnz / ranks + 8. * 22 * n + basis;
   }
 } // namespace knee_contact

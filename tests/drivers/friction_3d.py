@@ -175,6 +175,7 @@ def main():
     # they must have been taken, so that its comparison with the sparse
     # path covers them.
     tied_springs = 0
+    recomputed = 0
     with tempfile.TemporaryDirectory() as folder:
         # 1. mu = 0.
         for name, tolerance, plain, other in mu_zero_runs(
@@ -277,6 +278,8 @@ def main():
                             "stale_factor_solves"]
                         tied_springs += found["iterative"]["solver"][
                             "tied_springs"]
+                        recomputed += found["iterative"]["solver"][
+                            "amg_recomputed"]
                         # The condensed and sparse paths take the Newton
                         # step on the bound (ContactSystem::
                         # set_bound_couplings: the dense multiplier system,
@@ -324,6 +327,11 @@ def main():
         print("the iterative path held %d springs as rows (must be > 0)"
               % tied_springs)
         failures += tied_springs == 0
+        # The agreement above holds for hierarchies ML recomputed on an
+        # earlier set's aggregates (IterativeContactSystem::build_amg()).
+        print("the iterative path recomputed %d hierarchies on earlier "
+              "aggregates (must be > 0)" % recomputed)
+        failures += recomputed == 0
         # 5. The pictures of a frictional 3D interface: the pressure map
         # and the stick/slip map (scripts/plot_results_3d.py) are written.
         R = rotation(0.7)
