@@ -296,13 +296,13 @@ namespace knee_contact
     const double nnz = sparsity.n_nonzero_elements();
     const double iterative_bytes =
       IterativeContactSystem::estimated_bytes(sparsity, friction);
-    // With the Newton step's springs (3D knee, 2.3e5 dofs, mu = 0.04, the
-    // four cases of its stance, 2026-11-27): 0.8 set-ups per Newton
-    // iteration at about 115 ns per entry, 28 to 40 CG iterations per
-    // Newton iteration.
+    // With the Newton step's springs (3D knee, 1.25e5 dofs, mu = 0.04, the
+    // first case of its stance, 2026-11-28): 0.9 set-ups per Newton
+    // iteration, recomputed on the first hierarchy's aggregates at about
+    // 50 ns per entry, 21 Krylov iterations per Newton iteration.
     const double krylov_iterations =
-      (newton ? 40 : 30) * iterative_iterations + 150;
-    const double setup_ns = newton ? 115 * 0.8 * iterative_iterations : 75;
+      (newton ? 21 : 30) * iterative_iterations + 150;
+    const double setup_ns = newton ? 50 * 0.9 * iterative_iterations : 75;
     // Several ranks share the iterative path's work (the direct paths run
     // whole on each).
     const double iterative_seconds =
