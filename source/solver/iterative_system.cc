@@ -554,46 +554,39 @@ namespace knee_contact
     // every set.
     const types::global_dof_index n = matrix.m();
     std::vector<bool>             of_set(n, false);
-    const auto                    mark = [&](const types::global_dof_index i) {
-      of_set[i] = true;
-    };
     for (const auto &line : constraints.get_lines())
       {
         const auto *in_base = base.get_constraint_entries(line.index);
         if (in_base != nullptr && *in_base == line.entries)
           continue;
-        mark(line.index);
+        of_set[line.index] = true;
         for (const auto &[master, weight] : line.entries)
-          mark(master);
+          of_set[master] = true;
         for (auto entry = matrix.begin(line.index);
              entry != matrix.end(line.index);
              ++entry)
-          mark(entry->column());
+          of_set[entry->column()] = true;
       }
     for (const auto &line : constraints.get_lines())
       if (of_set[line.index])
         for (const auto &[master, weight] : line.entries)
-          mark(master);
+          of_set[master] = true;
 
-    std::vector<bool> remake(n, !amg_filled);
-    if (amg_filled)
-      {
-        for (const auto i : amg_set_rows)
-          remake[i] = true;
-        for (types::global_dof_index i = 0; i < n; ++i)
-          remake[i] = remake[i] || of_set[i];
-      }
+    // This rank's rows to make: all on the first call, else this set's and
+    // the last set's.
+    std::vector<bool> remake(n, false);
+    for (const auto i : amg_set_rows)
+      remake[i] = true;
     std::vector<types::global_dof_index> rows;
     amg_set_rows.clear();
     for (const auto row : owned)
       {
+        remake[row] = !amg_filled || remake[row] || of_set[row];
         if (remake[row])
           rows.push_back(row);
         if (of_set[row])
           amg_set_rows.push_back(row);
       }
-    for (types::global_dof_index i = 0; i < n; ++i)
-      remake[i] = remake[i] && owned.is_element(i);
 
     if (row_sums.empty())
       row_sums.reinit(matrix.get_sparsity_pattern());
