@@ -25,6 +25,7 @@
 #include <future>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <new>
 #include <set>
@@ -153,11 +154,12 @@ namespace knee_contact
   {
     ContactProblem<dim> blank;
     ParameterHandler    prm;
-    blank.add_parameters(prm, Counts{0, 0, 0});
+    blank.add_parameters(prm, Counts{0, 0, 0, 0});
     parse_scene(prm, scene_file, true);
     return Counts{blank.materials.n_materials,
                   blank.boundary_conditions.n_conditions,
-                  blank.contact_interfaces.n_interfaces};
+                  blank.contact_interfaces.n_interfaces,
+                  blank.motions.n_motions};
   }
 
 
@@ -194,6 +196,7 @@ namespace knee_contact
     contact_interfaces.add_parameters(prm, counts.n_interfaces);
     active_set_solver.add_parameters(prm);
     load_cases.add_parameters(prm);
+    motions.add_parameters(prm, counts.n_motions);
     output_writer.add_parameters(prm);
     verification.add_parameters(prm);
     refinement.add_parameters(prm);
@@ -219,6 +222,10 @@ namespace knee_contact
                            "Interface",
                            counts.n_interfaces,
                            "Number of interfaces");
+    outline.check_numbered("Load cases",
+                           "Motion",
+                           counts.n_motions,
+                           "Number of motions");
     // Each entry is bound to the member it sets (add_parameter): parsing
     // fills them and refuses a value that does not match its pattern, with
     // the file and line; the checks that patterns cannot make follow.
@@ -235,6 +242,7 @@ namespace knee_contact
     active_set_solver.check_parameters(materials.max_youngs_modulus(),
                                        materials.min_youngs_modulus());
     load_cases.check_parameters();
+    motions.check_parameters(load_cases.values());
     output_writer.check_parameters(scene_file);
     verification.check_parameters();
     refinement.check_parameters();
@@ -276,6 +284,12 @@ namespace knee_contact
     body_of_cell = compute_body_ids(triangulation, n_bodies);
     scene_checks::check_joints(triangulation, body_of_cell);
     contact_interfaces.check_mesh(triangulation, body_of_cell);
+    // Moved bodies at the pose of the case being solved (the scene's mesh
+    // is the pose's reference).
+    motions.check_mesh(triangulation);
+    motions.move(triangulation,
+                 std::numeric_limits<double>::quiet_NaN(),
+                 load_parameter);
   }
 
 

@@ -174,18 +174,23 @@ namespace knee_contact
       {
         std::cout << "load case " << c << ": t = " << t[c] << std::endl;
         set_load_parameter(t[c]);
-        Timer clock;
-        Timer case_clock;
+        Timer             clock;
+        Timer             case_clock;
+        std::vector<bool> guess = contact_solution.active;
         {
           TimerOutput::Scope scope(timer, "load cases: assembly");
-          ElasticityAssembler<dim>(materials, boundary_conditions)
-            .assemble_rhs(dof_handler, system_rhs);
+          if (motions.empty())
+            ElasticityAssembler<dim>(materials, boundary_conditions)
+              .assemble_rhs(dof_handler, system_rhs);
+          else
+            guess = move_to_case(t[c - 1], t[c]);
         }
         {
           TimerOutput::Scope scope(timer, "load cases: solve");
           // The previous case's active set is the guess: loads along a
-          // cycle change little from case to case.
-          solve_contact(contact_solution.active, false);
+          // cycle change little from case to case. Moved bodies: a new
+          // mesh position, a new system.
+          solve_contact(guess, !motions.empty(), !motions.empty());
         }
         const double solve_time = clock.wall_time();
         Results<dim> results;

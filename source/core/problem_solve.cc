@@ -16,12 +16,14 @@
 
 #include <deal.II/numerics/rtree.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <functional>
 #include <iomanip>
 #include <iostream>
 #include <iterator>
+#include <map>
 #include <new>
 
 namespace knee_contact
@@ -69,6 +71,14 @@ namespace knee_contact
             make_mesh(cycle);
           else
             {
+              // A refined mesh keeps its pose; its new vertices would lie
+              // where the scene's manifolds put them unmoved.
+              AssertThrow(motions.empty(),
+                          ExcMessage(
+                            "Load cases/Motion: moved bodies need a mesh "
+                            "made anew in each refinement cycle (a Gmsh "
+                            ".geo file with global refinement) or a single "
+                            "cycle; this scene refines its mesh"));
               resolved = !refinement.refine(strategy,
                                             triangulation,
                                             access(),
@@ -366,7 +376,8 @@ namespace knee_contact
   template <int dim>
   void
   ContactProblem<dim>::solve_contact(const std::vector<bool> &guess,
-                                     const bool               new_matrix)
+                                     const bool               new_matrix,
+                                     const bool               continue_path)
   {
     const RigidModes<dim> rigid_modes(dof_handler, body_of_cell, body_names);
     std::ostream         &loop_log = contact_pairs.empty() ? quiet : std::cout;
@@ -414,8 +425,9 @@ namespace knee_contact
         else
           {
             std::vector<double> accumulated =
-              path_step ? contact_solution.accumulated_slip
-                        : std::vector<double>(contact_pairs.size(), 0.);
+              path_step || continue_path
+                ? contact_solution.accumulated_slip
+                : std::vector<double>(contact_pairs.size(), 0.);
             accumulated.resize(contact_pairs.size(), 0.);
             std::vector<FrictionBound> bounds(contact_pairs.size());
             for (unsigned int p = 0; p < contact_pairs.size(); ++p)
@@ -514,7 +526,9 @@ namespace knee_contact
 
   template <int dim>
   void
-  ContactProblem<dim>::hold_tangential_rows_at(const Vector<double> &u)
+  ContactProblem<dim>::hold_tangential_rows_at(
+    const Vector<double>              &u,
+    const std::vector<Tensor<1, dim>> &offsets)
   {
     // friction_rows: N, T_j and S_k = sum_i c[k][i] [N; T]_i
     // (FrictionRowLayout, stick_coefficients()).
@@ -528,7 +542,11 @@ namespace knee_contact
         for (unsigned int j = 0; j + 1 < dim; ++j)
           {
             ContactRow  &t_row = friction_rows[at.tangential(j, p)];
-            const double shift = t_row.jump(u) - t_row.gap;
+            const double shift =
+              t_row.jump(u) - t_row.gap -
+              (offsets.empty()
+                 ? 0.
+                 : contact_pairs.points[p].tangents[j] * offsets[p]);
             t_row.gap += shift;
             t_row.reduced_gap += shift;
             for (unsigned int k = 0; k < dim; ++k)
@@ -539,6 +557,79 @@ namespace knee_contact
               }
           }
       }
+  }
+
+
+
+  template <int dim>
+  std::vector<bool>
+  ContactProblem<dim>::move_to_case(const double t_from, const double t_to)
+  {
+    // A pair is its interface's slave vertex: the key that survives the
+    // new search (the slave vertex may now face another master face, or
+    // none).
+    std::map<std::pair<unsigned int, types::global_dof_index>, unsigned int>
+      previous_pair;
+    for (unsigned int p = 0; p < contact_pairs.size(); ++p)
+      previous_pair[{contact_pairs.rows[p].interface,
+                     contact_pairs.points[p].slave_dofs[0]}] = p;
+    const ContactSolution previous = contact_solution;
+    // The previous displacements in this case's frame.
+    Vector<double> previous_u = displacement;
+    motions.rotate_displacements(dof_handler, t_from, t_to, previous_u);
+
+    motions.move(triangulation, t_from, t_to);
+    setup_system();
+    // The same cells and element: the same dof numbering.
+    AssertThrow(dof_handler.n_dofs() == previous_u.size(), ExcInternalError());
+    ElasticityAssembler<dim>(materials, boundary_conditions)
+      .assemble(dof_handler, system_matrix, system_rhs);
+
+    const unsigned int  n = contact_pairs.size();
+    std::vector<bool>   guess(n, false);
+    std::vector<double> accumulated(n, 0.);
+    for (unsigned int p = 0; p < n; ++p)
+      {
+        const auto found =
+          previous_pair.find({contact_pairs.rows[p].interface,
+                              contact_pairs.points[p].slave_dofs[0]});
+        if (found == previous_pair.end())
+          continue;
+        const unsigned int q = found->second;
+        guess[p]             = q < previous.active.size() && previous.active[q];
+        if (q < previous.accumulated_slip.size())
+          accumulated[p] = previous.accumulated_slip[q];
+      }
+    if (contact_pairs.frictional())
+      {
+        // Each pair's rigid motion since the previous case: that of its
+        // slave vertex against the master point it now faces. The master
+        // side moves as the row's largest entry of another motion than the
+        // slave's (a row's entries are the slave vertex, perhaps slave
+        // neighbours, and the master face's vertices); none: both sides
+        // move alike.
+        const std::vector<unsigned int> motion_of_dof =
+          motions.motion_of_dofs(dof_handler);
+        std::vector<Tensor<1, dim>> offsets(n);
+        for (unsigned int p = 0; p < n; ++p)
+          {
+            const ContactPoint<dim> &point = contact_pairs.points[p];
+            const unsigned int       slave = motion_of_dof[point.slave_dofs[0]];
+            unsigned int             master  = slave;
+            double                   largest = 0;
+            for (const auto &[dof, value] : contact_pairs.rows[p].row)
+              if (motion_of_dof[dof] != slave && std::abs(value) > largest)
+                {
+                  largest = std::abs(value);
+                  master  = motion_of_dof[dof];
+                }
+            offsets[p] = motions.relative_motion(
+              slave, master, point.position, t_from, t_to);
+          }
+        hold_tangential_rows_at(previous_u, offsets);
+      }
+    contact_solution.accumulated_slip = std::move(accumulated);
+    return guess;
   }
 
 
@@ -574,6 +665,7 @@ namespace knee_contact
   void
   ContactProblem<dim>::set_load_parameter(const double t)
   {
+    load_parameter = t;
     materials.set_load_parameter(t);
     boundary_conditions.set_load_parameter(t);
     verification.set_load_parameter(t);
@@ -585,10 +677,13 @@ namespace knee_contact
   template std::vector<CycleRecord> ContactProblem<dim>::run_cycles(          \
     const Refinement::Strategy, TimerOutput &, Results<dim> &);               \
   template void ContactProblem<dim>::solve_contact(const std::vector<bool> &, \
+                                                   const bool,                \
                                                    const bool);               \
-  template Results<dim> ContactProblem<dim>::current_results() const;         \
-  template Quantities   ContactProblem<dim>::cycle_quantities(                \
-    const Results<dim> &) const;                                            \
+  template std::vector<bool> ContactProblem<dim>::move_to_case(const double,  \
+                                                               const double); \
+  template Results<dim>      ContactProblem<dim>::current_results() const;    \
+  template Quantities        ContactProblem<dim>::cycle_quantities(           \
+    const Results<dim> &) const;                                       \
   template void ContactProblem<dim>::set_load_parameter(const double);
   KNEE_CONTACT_INSTANTIATE(2)
   KNEE_CONTACT_INSTANTIATE(3)

@@ -412,6 +412,13 @@ namespace knee_contact
         if (lambda_scale == 0)
           lambda_scale = 1;
         const double u_scale = std::max(system.displacement_scale(), 1e-300);
+        // The slips' own scale where they exceed the displacements: a
+        // moved body's slip counts its rigid sliding (Load cases/Motion:
+        // 0.3 m on a block whose displacements are 1e-4 m; measured there
+        // with u_scale, a slip direction right to round-off left 1.5e-10).
+        double slip_scale = u_scale;
+        for (const auto &s : slip)
+          slip_scale = std::max(slip_scale, magnitude(s));
         const double force_scale = rhs.linfty_norm() + lambda_scale;
 
         std::vector<bool>             next(at.size(), false);
@@ -478,7 +485,12 @@ namespace knee_contact
             if (sticking_in(active, p))
               {
                 const double t_norm = magnitude(t_force);
-                stick               = t_norm <= bound + 1e-12 * force_scale;
+                // Within half the tolerance the residual allows: a pair
+                // held at its bound (a load path that stops after sliding)
+                // exceeds it by the solve's round-off, 1e-11 of the forces
+                // on a dragged block, and at 1e-12 half the pairs slipped
+                // and stuck in turn without end.
+                stick = t_norm <= bound + 0.5 * tolerance * lambda_scale;
                 if (t_norm > 0)
                   direction = unit(t_force);
                 result.complementarity =
@@ -510,8 +522,8 @@ namespace knee_contact
                 if (bound > 0)
                   result.complementarity =
                     std::max({result.complementarity,
-                              std::max(0., -along) / u_scale,
-                              across / u_scale});
+                              std::max(0., -along) / slip_scale,
+                              across / slip_scale});
                 if (bound > 0)
                   {
                     // The semismooth rule of Hueber, Stadler and

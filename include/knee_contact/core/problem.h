@@ -5,6 +5,7 @@
 #include <knee_contact/mesh/mesh.h>
 #include <knee_contact/physics/boundary_conditions.h>
 #include <knee_contact/physics/materials.h>
+#include <knee_contact/physics/rigid_motions.h>
 #include <knee_contact/postprocess/load_cases.h>
 #include <knee_contact/postprocess/output.h>
 #include <knee_contact/postprocess/problem_access.h>
@@ -84,6 +85,7 @@ namespace knee_contact
       unsigned int n_materials  = 1;
       unsigned int n_conditions = 1;
       unsigned int n_interfaces = 1;
+      unsigned int n_motions    = 1;
     };
 
     static Counts
@@ -230,10 +232,25 @@ namespace knee_contact
     /**
      * Solve the contact problem for the current system_rhs, from the active
      * set @p guess: with a new contact system (factorisation) if
-     * @p new_matrix, else reusing the last one (a further load case).
+     * @p new_matrix, else reusing the last one (a further load case). With
+     * friction, @p continue_path: the case continues a load path on a new
+     * system (move_to_case() held the rows and carried the slip over).
      */
     void
-    solve_contact(const std::vector<bool> &guess, const bool new_matrix);
+    solve_contact(const std::vector<bool> &guess,
+                  const bool               new_matrix,
+                  const bool               continue_path = false);
+
+    /**
+     * A further load case with Load cases/Motion: place the moved bodies
+     * from the pose at @p t_from to that at @p t_to, find the pairs again,
+     * assemble, and carry each slave vertex's state over (its active flag,
+     * returned as the guess, its accumulated slip, and with friction the
+     * tangential rows held where the previous case left the pair: its
+     * elastic jump, turned with the bodies, less the rigid sliding since).
+     */
+    std::vector<bool>
+    move_to_case(const double t_from, const double t_to);
 
     /** The derived quantities (compute_results()) of the current solution. */
     Results<dim>
@@ -297,9 +314,12 @@ namespace knee_contact
     ContactInterfaces       contact_interfaces;
     ActiveSetSolver         active_set_solver;
     LoadCases               load_cases;
-    OutputWriter<dim>       output_writer;
-    Verification<dim>       verification;
-    Refinement              refinement;
+    RigidMotions<dim>       motions;
+    /** The load parameter of the case being solved (set_load_parameter()). */
+    double            load_parameter = 0;
+    OutputWriter<dim> output_writer;
+    Verification<dim> verification;
+    Refinement        refinement;
 
     Triangulation<dim> triangulation;
     // FE_Q(1)^dim or FE_SimplexP(1)^dim, by the mesh's cells (make_mesh).
@@ -395,10 +415,14 @@ namespace knee_contact
     /**
      * With friction, along a load path: the gaps of the tangential rows
      * (and of the rows that hold sticking pairs) become the tangential
-     * jumps of @p u, so that a pair sticks where it is.
+     * jumps of @p u, so that a pair sticks where it is; with @p offsets
+     * (one per pair, a moved case) less t_j . offset, the pair's rigid
+     * slip since (RigidMotions::relative_motion()): the slip of the case
+     * counts it.
      */
     void
-    hold_tangential_rows_at(const Vector<double> &u);
+    hold_tangential_rows_at(const Vector<double>              &u,
+                            const std::vector<Tensor<1, dim>> &offsets = {});
 
     /** The rows the contact system and the active-set loop see. */
     const std::vector<ContactRow> &
