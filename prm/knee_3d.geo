@@ -12,21 +12,32 @@
 // 2 femoral top (the axial load), 3 the femoral plate's sides (guided:
 // sliding), 4 medial dish, 5 lateral dish (slaves), 6 medial condyle,
 // 7 lateral condyle (masters).
-// Cells of size h_contact within 12 mm of the contact points, growing to
-// h_far.
+// Cells of size h_contact within fine_radius (12 mm) of the contact points,
+// growing to h_far. With trough = 1 the dishes are troughs instead: cylinders
+// of radius 40 mm along y (the same frontal conformity, none in the sagittal
+// plane), so that an anterior-posterior translation or a small internal-
+// external rotation of the tibial side leaves the femoral component seated
+// (prm/knee_3d_iso_friction.prm); condyle_cylinder is the radius of the
+// cylinders the condyles are cut from (13 mm).
 SetFactory("OpenCASCADE");
-DefineConstant[ h_contact = 1.2, h_far = 6 ];
+DefineConstant[ h_contact = 1.2, h_far = 6, trough = 0, condyle_cylinder = 13,
+                fine_radius = 12 ];
 Box(1) = {-38, -22, -40, 76, 44, 30};   // tibia
 Box(2) = {-38, -22, -10, 76, 44, 4};    // tray
 Box(3) = {-38, -22, -6, 76, 44, 12};    // insert, top at z = 6
-Sphere(4) = {-20, 0, 42, 40};
-Sphere(5) = {20, 0, 42, 40};
+If (trough)
+  Cylinder(4) = {-20, -30, 42, 0, 60, 0, 40};
+  Cylinder(5) = {20, -30, 42, 0, 60, 0, 40};
+Else
+  Sphere(4) = {-20, 0, 42, 40};
+  Sphere(5) = {20, 0, 42, 40};
+EndIf
 BooleanDifference(6) = { Volume{3}; Delete; }{ Volume{4, 5}; Delete; };
 Sphere(7) = {-20, 0, 38, 36};
-Cylinder(8) = {-20, 0, 2, 0, 0, 12, 13};
+Cylinder(8) = {-20, 0, 2, 0, 0, 12, condyle_cylinder};
 BooleanIntersection(9) = { Volume{7}; Delete; }{ Volume{8}; Delete; };
 Sphere(10) = {20, 0, 38, 36};
-Cylinder(11) = {20, 0, 2, 0, 0, 12, 13};
+Cylinder(11) = {20, 0, 2, 0, 0, 12, condyle_cylinder};
 BooleanIntersection(12) = { Volume{10}; Delete; }{ Volume{11}; Delete; };
 Box(13) = {-38, -22, 14, 76, 44, 8};   // femoral plate
 BooleanUnion(14) = { Volume{13}; Delete; }{ Volume{9, 12}; Delete; };
@@ -49,10 +60,12 @@ sides[] -= {plate_bottom[]};
 // OpenCASCADE's boxes of curved faces are loose: each side's faces are
 // found in generous boxes, the other body's faces taken out.
 femur[] = Abs(Boundary{ Volume{14}; });
-medial_condyle[] = Surface In BoundingBox{-36, -16, 2 - e, -4, 16, 10};
-lateral_condyle[] = Surface In BoundingBox{4, -16, 2 - e, 36, 16, 10};
-medial_dish[] = Surface In BoundingBox{-38.5, -19, 2 - e, -1.5, 19, 6 + e};
-lateral_dish[] = Surface In BoundingBox{1.5, -19, 2 - e, 38.5, 19, 6 + e};
+rc = condyle_cylinder + 3;
+medial_condyle[] = Surface In BoundingBox{-20 - rc, -rc, 2 - e, -20 + rc, rc, 10};
+lateral_condyle[] = Surface In BoundingBox{20 - rc, -rc, 2 - e, 20 + rc, rc, 10};
+dy = trough ? 22.5 : 19;
+medial_dish[] = Surface In BoundingBox{-38.5, -dy, 2 - e, -1.5, dy, 6 + e};
+lateral_dish[] = Surface In BoundingBox{1.5, -dy, 2 - e, 38.5, dy, 6 + e};
 medial_dish[] -= {femur[]};
 lateral_dish[] -= {femur[]};
 Physical Surface(1) = {bottom[]};
@@ -64,11 +77,11 @@ Physical Surface(6) = {medial_condyle[]};
 Physical Surface(7) = {lateral_condyle[]};
 Field[1] = Ball;
 Field[1].XCenter = -20; Field[1].YCenter = 0; Field[1].ZCenter = 2;
-Field[1].Radius = 12; Field[1].Thickness = 10;
+Field[1].Radius = fine_radius; Field[1].Thickness = 10;
 Field[1].VIn = h_contact; Field[1].VOut = h_far;
 Field[2] = Ball;
 Field[2].XCenter = 20; Field[2].YCenter = 0; Field[2].ZCenter = 2;
-Field[2].Radius = 12; Field[2].Thickness = 10;
+Field[2].Radius = fine_radius; Field[2].Thickness = 10;
 Field[2].VIn = h_contact; Field[2].VOut = h_far;
 Field[3] = Min;
 Field[3].FieldsList = {1, 2};

@@ -21,7 +21,9 @@ namespace knee_contact
    * case. The mesh, the constraints and the factorisation are those of the
    * first case; each further case assembles only its load vector and runs
    * the active-set loop from the previous case's active set
-   * (ContactSystem::set_rhs()).
+   * (ContactSystem::set_rhs()). Where Load cases/Motion moves bodies
+   * (RigidMotions) each case is set up anew at its pose instead
+   * (ContactProblem::move_to_case()).
    */
   class LoadCases
   {
