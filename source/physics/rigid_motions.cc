@@ -131,9 +131,27 @@ namespace knee_contact
           entry.translation, dim, motion.name + "/Translation", "", true);
         motions.push_back(std::move(motion));
       }
-    for (unsigned int m = 0; m < motions.size(); ++m)
+    // Each case's pose is finite and, expressions in t alone, one rigid
+    // motion of the body.
+    Point<dim> elsewhere;
+    for (unsigned int d = 0; d < dim; ++d)
+      elsewhere[d] = 0.5 + d;
+    for (const auto &motion : motions)
       for (const double t_case : t)
-        pose(m, t_case);
+        {
+          pose(&motion - motions.data(), t_case);
+          for (const auto &[function, entry_name] :
+               {std::make_pair(motion.angle.get(), "Rotation angle"),
+                std::make_pair(motion.translation.get(), "Translation")})
+            for (unsigned int c = 0; c < function->n_components; ++c)
+              AssertThrow(function->value(Point<dim>(), c) ==
+                            function->value(elsewhere, c),
+                          ExcMessage("parameter '" + motion.name + "/" +
+                                     entry_name +
+                                     "': an expression in t alone (x, y "
+                                     "and z would make the motion "
+                                     "non-rigid)"));
+        }
   }
 
 
