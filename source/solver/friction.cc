@@ -434,6 +434,14 @@ namespace knee_contact
         // sliding block).
         double       bound_change = 0;
         unsigned int n_contact = 0, n_stick = 0;
+        // As in solve(): the first step from bodies held at points.
+        std::vector<bool> contact_now(n);
+        for (unsigned int p = 0; p < n; ++p)
+          contact_now[p] = in_contact(p);
+        const std::vector<double> entry =
+          iteration == 1 && guess.empty()
+            ? first_step_thresholds(rows, excess, contact_now)
+            : std::vector<double>(n, 0.);
         for (unsigned int p = 0; p < n; ++p)
           {
             result.max_penetration =
@@ -444,7 +452,7 @@ namespace knee_contact
                                          -excess[p] / u_scale)));
             const bool contact =
               rows[p].eliminated != numbers::invalid_dof_index &&
-              (lambda[p] + c * excess[p] > 0 ||
+              (lambda[p] + c * (excess[p] - entry[p]) > 0 ||
                (in_contact(p) && lambda[p] >= -1e-12 * force_scale));
             if (!contact)
               continue;

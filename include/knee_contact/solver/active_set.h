@@ -242,6 +242,32 @@ namespace knee_contact
                      const std::function<void(unsigned int)> &close);
 
     /**
+     * The first step of a cold start (no guess): the penetration a pair
+     * must exceed to enter the set in the first iteration. On an interface
+     * whose first solve held it at points (more than
+     * first_step_spread times as many pairs penetrate as were in contact)
+     * a fraction 1 - first_step_length of the deepest penetration there
+     * (@p excess of the pairs p < in_contact.size() not @p in_contact, the
+     * first rows of @p rows); elsewhere 0. Why: a body held at a point
+     * sinks by the point's local compliance, F / (E h), which grows as the
+     * mesh is refined, and its penetration zone overestimates the contact
+     * zone by as much (see the code).
+     */
+    static std::vector<double>
+    first_step_thresholds(const std::vector<ContactRow> &rows,
+                          const std::vector<double>     &excess,
+                          const std::vector<bool>       &in_contact);
+
+    /**
+     * The length of the first step from bodies held at points, as a
+     * fraction of the deepest penetration, and the ratio of penetrating to
+     * contact pairs that says an interface was held at points
+     * (first_step_thresholds()).
+     */
+    static constexpr double first_step_spread = 10;
+    static constexpr double first_step_length = 0.1;
+
+    /**
      * One sparsity pattern for the condensed systems of every active set of
      * @p pairs under @p base (see the comment in the code);
      * @p cycles_allowed with friction, whose rows are not all active
