@@ -7,6 +7,8 @@
 
 #include <deal.II/base/multithread_info.h>
 
+#include <unistd.h>
+
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
@@ -39,6 +41,66 @@ namespace
     knee_contact::interruption::remove_registered();
     std::_Exit(knee_contact::ExitCode::input_error);
   }
+
+  /**
+   * deal.II reads DEAL_II_NUM_THREADS while its library is loaded, before
+   * main(), and a value it cannot read (empty, a word, 0) ends the program
+   * by an uncaught exception: an abort with a page of text. Checked first
+   * here: an executable's .preinit_array runs before the initialisers of
+   * the shared libraries it loads (System V ABI), before libc is set up:
+   * only the environment it is given, write() and _exit() are used. Under
+   * mpirun rank 0 alone prints (every rank leaves).
+   */
+  void
+  check_thread_variable(int, char **, char **environment)
+  {
+    // (getenv() may not work yet: libc has not set its environ.)
+    const auto variable = [environment](const char *name) -> const char * {
+      const std::size_t length = std::strlen(name);
+      for (char **e = environment; e != nullptr && *e != nullptr; ++e)
+        if (std::strncmp(*e, name, length) == 0 && (*e)[length] == '=')
+          return *e + length + 1;
+      return nullptr;
+    };
+    const char *value = variable("DEAL_II_NUM_THREADS");
+    if (value == nullptr)
+      return;
+    // What deal.II reads: an integer, with blanks around it; a positive
+    // one of at most 9 digits is taken here.
+    const char *c = value;
+    while (*c == ' ' || *c == '\t')
+      ++c;
+    if (*c == '+')
+      ++c;
+    unsigned int digits = 0, nonzero = 0;
+    for (; *c >= '0' && *c <= '9'; ++c, ++digits)
+      nonzero += *c != '0';
+    while (*c == ' ' || *c == '\t')
+      ++c;
+    if (*c == '\0' && digits > 0 && digits <= 9 && nonzero > 0)
+      return;
+    const char *rank = variable("OMPI_COMM_WORLD_RANK");
+    if (rank == nullptr || std::strcmp(rank, "0") == 0)
+      {
+        char   line[200] = "knee_contact: error: environment variable "
+                           "DEAL_II_NUM_THREADS = '";
+        size_t n         = std::strlen(line);
+        // The value, printable characters only, cut at 40.
+        for (const char *v = value; *v != '\0' && v - value < 40; ++v)
+          line[n++] = (*v >= ' ' && *v <= '~') ? *v : '?';
+        const char tail[] = "' is not a positive number of threads (unset "
+                            "it to use every core)\n";
+        std::memcpy(line + n, tail, sizeof(tail) - 1);
+        n += sizeof(tail) - 1;
+        [[maybe_unused]] const auto written = ::write(2, line, n);
+      }
+    ::_exit(knee_contact::ExitCode::input_error);
+  }
+
+  [[gnu::used, gnu::section(".preinit_array")]] void (
+      *const check_thread_variable_first)(int,
+                                          char **,
+                                          char **) = &check_thread_variable;
 
   /** The run; a failure's one-line @p message is printed by the caller. */
   int
