@@ -369,9 +369,14 @@ namespace knee_contact
     // iteration's set, the iterations; one threshold for both interfaces):
     // at 6.5e4 dofs (a contact zone of 29 pairs) 0: 361, 9; 0.25: 270, 8;
     // 0.5: 175, 7; 0.75: 76, 6; 0.9: 21, 6. At 1.4e5 dofs (55 pairs) 0:
-    // 852, 11; 0.75: 201, 7; 0.9: 54, 6. With 0.9 per interface, as here:
-    // 43, 5 and 6 iterations; the 3D Hertz scenes of the tests 9 to 5 and
-    // 13 to 7, the 2D knees unchanged (doc/friction.md).
+    // 852, 11; 0.75: 201, 7; 0.9: 54, 6. Per interface, as here, the first
+    // case with friction (mu = 0.04) and without, 0.9 / 0.97 / 0.99: at
+    // 6.5e4 dofs 8 / 9 / 11 and 5 / 6 / 7 iterations; at 1.4e5 12 / 10 / 12
+    // and 6 / 6 / 7; at 2.4e5 with friction 12 / 11 / -; the axial-force
+    // path (prm/knee_3d_gait_friction.prm) at 1.2e5 dofs 14 / 13 / - and
+    // at 2.3e5 16 / 14 / 13 (the damped zone 734 / 342 / 170 pairs for 286):
+    // the point's overshoot grows as the mesh is refined, so the finer
+    // meshes, where the iterations cost, take the smaller step.
     const unsigned int n = in_contact.size();
     AssertThrow(n <= rows.size() && n <= excess.size(), ExcInternalError());
     // Per interface: the pairs in contact, those that penetrate, the

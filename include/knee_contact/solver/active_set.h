@@ -265,7 +265,7 @@ namespace knee_contact
      * (first_step_thresholds()).
      */
     static constexpr double first_step_spread = 10;
-    static constexpr double first_step_length = 0.1;
+    static constexpr double first_step_length = 0.03;
 
     /**
      * One sparsity pattern for the condensed systems of every active set of
