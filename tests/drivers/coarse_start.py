@@ -14,8 +14,10 @@ Reference: the same scene without the coarse start. Asserted: the same
 exit code and active pairs (contact_*.csv), every figure of summary.json
 (energy, max |u|, reactions, load, interface forces, peak pressures, tau_yy
 ranges) equal to 1e-9 relative to its scale (the iterative and direct
-paths stop at 1e-12 and 1e-10), and, on the two Hertz scenes, fewer
-active-set iterations on the run's mesh. A scene that cannot be made
+paths stop at 1e-12 and 1e-10), and fewer active-set iterations on the
+run's mesh on the 2D Hertz scene, no more on the 3D one (since the cold
+start's first step from a body held at a point is damped, 2026-11-28, it
+takes 4 iterations there too, 7 to 13 before). A scene that cannot be made
 coarser (a .msh-less Rectangles scene without refinements) is refused in
 one line naming the parameter.
 Usage: coarse_start.py KNEE_CONTACT
@@ -68,10 +70,10 @@ def fine_iterations(log):
 def main():
     binary = os.path.abspath(sys.argv[1])
     failures = 0
-    cases = [("hertz_3d", "hertz_sphere_3d_small.prm", "", True),
-             ("hertz_2d", "hertz_small.prm", "", True),
+    cases = [("hertz_3d", "hertz_sphere_3d_small.prm", "", "no more"),
+             ("hertz_2d", "hertz_small.prm", "", "fewer"),
              ("separation", "contact_separation.prm",
-              "subsection Mesh\n  set Global refinements = 2\nend\n", False)]
+              "subsection Mesh\n  set Global refinements = 2\nend\n", "")]
     with tempfile.TemporaryDirectory() as folder:
         for name, base, extra, fewer in cases:
             runs = {}
@@ -101,8 +103,11 @@ def main():
                   "coarse start" % (name, worst, TOLERANCE, it0, it1))
             if worst > TOLERANCE:
                 failures += 1
-            if fewer and not it1 < it0:
+            if fewer == "fewer" and not it1 < it0:
                 print("%s: the coarse start saved no iteration" % name)
+                failures += 1
+            if fewer == "no more" and not it1 <= it0:
+                print("%s: the coarse start cost iterations" % name)
                 failures += 1
         # A mesh that cannot be made coarser: refused in one line.
         code, log = run(binary, scene(folder, "refused",
