@@ -435,13 +435,14 @@ namespace knee_contact
         double       bound_change = 0;
         unsigned int n_contact = 0, n_stick = 0;
         // As in solve(): the first step from bodies held at points.
-        std::vector<bool> contact_now(n);
-        for (unsigned int p = 0; p < n; ++p)
-          contact_now[p] = in_contact(p);
-        const std::vector<double> entry =
-          iteration == 1 && guess.empty()
-            ? first_step_thresholds(rows, excess, contact_now)
-            : std::vector<double>(n, 0.);
+        std::vector<double> entry(n, 0.);
+        if (iteration == 1 && guess.empty())
+          {
+            std::vector<bool> contact_now(n);
+            for (unsigned int p = 0; p < n; ++p)
+              contact_now[p] = in_contact(p);
+            entry = first_step_thresholds(rows, excess, contact_now);
+          }
         for (unsigned int p = 0; p < n; ++p)
           {
             result.max_penetration =
