@@ -1,7 +1,10 @@
 #include <knee_contact/base/interruption.h>
 #include <knee_contact/base/parallel.h>
 
+#include <deal.II/base/exceptions.h>
 #include <deal.II/base/multithread_info.h>
+
+#include <petscsys.h>
 
 #include <algorithm>
 #include <chrono>
@@ -156,6 +159,31 @@ namespace knee_contact
             interruption::unregister_folder(session_folder);
           }
       });
+    }
+
+
+
+    void
+    ensure_petsc()
+    {
+      PetscBool initialised = PETSC_FALSE;
+      PetscInitialized(&initialised);
+      if (initialised)
+        return;
+      ensure_initialised();
+      // PETSc reads its options from the command line it is given: this
+      // one, not the program's (whose arguments are the scene's).
+      static char name[] = "knee_contact", no_handlers[] = "-no_signal_handler",
+                  no_files[]   = "-skip_petscrc";
+      static char *arguments[] = {name, no_handlers, no_files, nullptr};
+      int          argc        = 3;
+      char       **argv        = arguments;
+      PETSC_COMM_WORLD         = communicator();
+      AssertThrow(PetscInitialize(&argc, &argv, nullptr, nullptr) == 0,
+                  dealii::ExcMessage("PETSc could not be initialised"));
+      PetscPushErrorHandler(PetscReturnErrorHandler, nullptr);
+      // Registered after MPI's finalisation, so run before it.
+      std::atexit([]() { PetscFinalize(); });
     }
 
 

@@ -405,6 +405,7 @@ namespace knee_contact
                                   rows_for_solver(),
                                   rigid_modes,
                                   active_set_solver.krylov_settings(),
+                                  active_set_solver.direct_factor(),
                                   !guess.empty(),
                                   output_writer.test_mode() ? quiet : loop_log);
             contact_system = std::move(choice.system);

@@ -71,6 +71,20 @@ namespace knee_contact
       "linear in the dofs (the path for large 3D meshes); step-41: condense "
       "and factorise the whole system with UMFPACK in every iteration (the "
       "first version's path, kept for comparison).");
+    input::add_selection(
+      prm,
+      "Direct factor",
+      factor,
+      std::vector<std::pair<std::string, DirectFactor>>{
+        {direct_factor_name(DirectFactor::automatic), DirectFactor::automatic},
+        {direct_factor_name(DirectFactor::cholmod), DirectFactor::cholmod},
+        {direct_factor_name(DirectFactor::mumps), DirectFactor::mumps}},
+      "The sparse path's factor. CHOLMOD: supernodal Cholesky, the whole "
+      "factor on every rank; MUMPS (through PETSc): multifrontal LDL^T "
+      "with the factor and its work divided over the ranks of an mpirun "
+      "(memory per rank about 1/N of the factor), and on one process the "
+      "sparse path whatever the automatic choice (doc/parallel.md); "
+      "automatic: MUMPS on more than one rank, CHOLMOD on one.");
     prm.add_parameter("Krylov tolerance",
                       krylov.tolerance,
                       "Iterative path: each accepted solve stops at this "

@@ -101,12 +101,18 @@ namespace knee_contact
          const std::vector<ContactRow>   &pairs,
          const RigidModeCheck            &rigid_modes,
          const KrylovSettings            &krylov,
+         const DirectFactor               requested_factor,
          const bool                       warm_start,
          std::ostream                    &log,
          std::string                     &name,
          std::map<std::string, double>   &figures)
   {
     figures["ranks"] = parallel::n_ranks();
+    // MUMPS's factor is divided over the ranks (its memory and its work);
+    // CHOLMOD's is whole on each.
+    const bool mumps =
+      resolve_direct_factor(requested_factor) == DirectFactor::mumps;
+    const double factor_ranks = mumps ? parallel::n_ranks() : 1.;
     if (requested == SolverPath::step41)
       {
         // The first version's path, kept for comparison: UMFPACK's memory
@@ -234,7 +240,13 @@ namespace knee_contact
     // its factor holds the dense k x k trailing block.
     const double matrix_bytes =
       12. * nnz_lower + 12. * sparsity.n_nonzero_elements();
-    const double sparse_bytes = 2 * 9.6 * lnz + matrix_bytes;
+    // MUMPS: its share of the factor on each rank, and PETSc's copy of
+    // the rank's rows of the matrix beside CHOLMOD's analysis.
+    const double sparse_bytes =
+      mumps ? 2 * 9.6 * lnz / factor_ranks +
+                (12. * sparsity.n_nonzero_elements() / factor_ranks +
+                 12. * sparsity.n_nonzero_elements())
+            : 2 * 9.6 * lnz + matrix_bytes;
     // With friction the Newton step on the bound adds, per tangential row,
     // its columns of W and G where it is not a loop row (2D: k + P) and at
     // most one coupled column of G per pair (P).
@@ -269,7 +281,7 @@ namespace knee_contact
                                  : friction   ? 1.0 * iterations
                                  : warm_start ? 1.3
                                               : 0.65 * iterations) *
-                                fl;
+                                fl / factor_ranks;
 
     std::string  limit;
     const double available = available_on_every_rank(limit);
@@ -315,8 +327,12 @@ namespace knee_contact
     std::string reason;
     if (requested == SolverPath::automatic)
       {
-        path   = condensed_flops <= sparse_flops ? SolverPath::condensed
-                                                 : SolverPath::sparse;
+        // A factor MUMPS is asked for by name: the sparse path (the
+        // condensed one needs CHOLMOD's partial solves).
+        path   = (requested_factor != DirectFactor::mumps &&
+                condensed_flops <= sparse_flops)
+                   ? SolverPath::condensed
+                   : SolverPath::sparse;
         reason = "estimated " + gigaflops(condensed_flops) +
                  " condensed (k = " + std::to_string(int(k)) +
                  " contact unknowns, P = " + std::to_string(int(P)) +
@@ -420,8 +436,15 @@ namespace knee_contact
           sparse = std::make_unique<SparseContactSystem>(matrix, base, pairs);
         }
     name = "sparse";
-    log << "   solver: sparse (" << reason << ")" << on_every_rank()
-        << std::endl;
+    log << "   solver: sparse (" << reason << ")";
+    if (mumps)
+      {
+        sparse->use_mumps();
+        log << ", MUMPS's factor distributed over " << parallel::n_ranks()
+            << (parallel::n_ranks() > 1 ? " ranks" : " rank") << std::endl;
+      }
+    else
+      log << on_every_rank() << std::endl;
     return sparse;
   }
 
@@ -434,6 +457,7 @@ namespace knee_contact
                       const std::vector<ContactRow>   &pairs,
                       const RigidModeCheck            &rigid_modes,
                       const KrylovSettings            &krylov,
+                      const DirectFactor               factor,
                       const bool                       warm_start,
                       std::ostream                    &log)
   {
@@ -444,6 +468,7 @@ namespace knee_contact
                            pairs,
                            rigid_modes,
                            krylov,
+                           factor,
                            warm_start,
                            log,
                            choice.name,

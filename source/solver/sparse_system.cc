@@ -96,12 +96,33 @@ namespace knee_contact
       , pairs(pairs)
     {}
 
+    /** The factor of the solves: MUMPS's if made, else CHOLMOD's. */
+    SparseFactor &
+    factor()
+    {
+      return distributed ? *distributed : cholesky;
+    }
+    const SparseFactor &
+    factor() const
+    {
+      if (distributed)
+        return *distributed;
+      return cholesky;
+    }
+
     const SparseMatrix<double>      &matrix;
     const AffineConstraints<double> &base;
     const std::vector<ContactRow>   &pairs;
     const Vector<double>            *rhs = nullptr;
-    sparse_cholesky::SparseCholesky  cholesky;
-    std::vector<int>                 order;
+    /**
+     * CHOLMOD's analysis (the cost estimates of the path) and, unless
+     * MUMPS's factor is taken, its factorisations.
+     */
+    sparse_cholesky::SparseCholesky cholesky;
+    /** MUMPS's factor, distributed over the ranks (Contact/Direct
+     * factor). */
+    std::unique_ptr<SparseFactor> distributed;
+    std::vector<int>              order;
     /** C condensed under the base active set A0 of the factor. */
     SparseMatrix<double>      condensed;
     AffineConstraints<double> constraints;
@@ -218,7 +239,7 @@ namespace knee_contact
     constraints.condense(condensed);
     factor_springs = springs;
     has_factor     = false;
-    if (!cholesky.factorise(condensed))
+    if (!factor().factorise(condensed))
       AssertThrow(false, ExcNotPositiveDefinite());
     has_factor  = true;
     base_active = active;
@@ -236,7 +257,7 @@ namespace knee_contact
   {
     sparse_cholesky::condense_homogeneous(constraints, b);
     std::vector<double> z(b.begin(), b.end());
-    cholesky.solve(CHOLMOD_A, z);
+    factor().solve(z);
     std::copy(z.begin(), z.end(), b.begin());
     sparse_cholesky::distribute_homogeneous(constraints, b);
   }
@@ -279,12 +300,12 @@ namespace knee_contact
     };
     struct Preconditioner
     {
-      sparse_cholesky::SparseCholesky &cholesky;
+      SparseFactor &factor;
       void
       vmult(Vector<double> &dst, const Vector<double> &src) const
       {
         std::vector<double> z(src.begin(), src.end());
-        cholesky.solve(CHOLMOD_A, z);
+        factor.solve(z);
         std::copy(z.begin(), z.end(), dst.begin());
       }
     };
@@ -302,12 +323,12 @@ namespace knee_contact
             control,
             SolverGMRES<Vector<double>>::AdditionalData(
               IterativeContactSystem::gmres_basis, true))
-            .solve(operation, y, b, Preconditioner{cholesky});
+            .solve(operation, y, b, Preconditioner{factor()});
         else
           SolverCG<Vector<double>>(control).solve(operation,
                                                   y,
                                                   b,
-                                                  Preconditioner{cholesky});
+                                                  Preconditioner{factor()});
       }
     catch (const SolverControl::NoConvergence &)
       {
@@ -391,6 +412,20 @@ namespace knee_contact
     clock.restart();
     d.cholesky.analyse(pattern, d.order, true);
     d.analysis = clock.wall_time();
+  }
+
+
+
+  void
+  SparseContactSystem::use_mumps()
+  {
+    Implementation &d = *implementation;
+    Assert(d.n_factorisations == 0, ExcInternalError());
+    Timer clock;
+    d.distributed = make_mumps_factor(d.matrix.get_sparsity_pattern());
+    // CHOLMOD keeps its analysis (the estimates), not its copy of C.
+    d.cholesky.release_matrix();
+    d.analysis += clock.wall_time();
   }
 
 
@@ -530,7 +565,7 @@ namespace knee_contact
         Vector<double> y(b.size());
         const auto     start = [&]() {
           std::vector<double> z(b.begin(), b.end());
-          d.cholesky.solve(CHOLMOD_A, z);
+          d.factor().solve(z);
           std::copy(z.begin(), z.end(), y.begin());
         };
         start();
@@ -554,7 +589,7 @@ namespace knee_contact
       }
     if (!d.has_factor || (n_new + 1) * correction_flops > d.cholesky.flops() ||
         (d.corrections.size() + n_new) * vector_MB >
-          std::max(d.cholesky.memory_MB(), 8 * vector_MB) ||
+          std::max(d.factor().memory_MB(), 8 * vector_MB) ||
         changed.size() > 500 || (!changed.empty() && stale()))
       {
         d.factorise(active);
@@ -587,7 +622,7 @@ namespace knee_contact
       if (!solved)
         {
           std::vector<double> z(b.begin(), b.end());
-          d.cholesky.solve(CHOLMOD_A, z);
+          d.factor().solve(z);
           d.x0.reinit(z.size());
           std::copy(z.begin(), z.end(), d.x0.begin());
         }
@@ -737,24 +772,26 @@ namespace knee_contact
   std::map<std::string, double>
   SparseContactSystem::statistics() const
   {
-    const Implementation &d = *implementation;
-    return {{"ordering", d.ordering},
-            {"analysis", d.analysis},
-            {"factorisation", d.factorisation},
-            {"factorisations", d.n_factorisations},
-            {"solves", d.n_solves},
-            {"bordered_updates", d.n_updates},
-            {"update_solves", d.n_corrections},
-            {"update_time", d.updates},
-            {"solve_and_multipliers", d.solves},
-            {"factor_memory_MB", d.cholesky.memory_MB()},
-            {"factor_flops", d.cholesky.flops()},
-            {"spring_sets", d.n_spring_sets},
-            {"stale_factor_solves", d.n_stale_factor_solves},
-            {"stale_factor_cg_iterations", d.stale_factor_iterations},
-            {"stale_factor_time", d.stale_factor_time},
-            {"coupled_solves", d.n_coupled_solves},
-            {"coupled_gmres_iterations", d.coupled_iterations},
-            {"coupled_time", d.coupled_time}};
+    const Implementation         &d       = *implementation;
+    std::map<std::string, double> figures = d.factor().statistics();
+    figures.insert({{"ordering", d.ordering},
+                    {"analysis", d.analysis},
+                    {"factorisation", d.factorisation},
+                    {"factorisations", d.n_factorisations},
+                    {"solves", d.n_solves},
+                    {"bordered_updates", d.n_updates},
+                    {"update_solves", d.n_corrections},
+                    {"update_time", d.updates},
+                    {"solve_and_multipliers", d.solves},
+                    {"factor_memory_MB", d.factor().memory_MB()},
+                    {"factor_flops", d.cholesky.flops()},
+                    {"spring_sets", d.n_spring_sets},
+                    {"stale_factor_solves", d.n_stale_factor_solves},
+                    {"stale_factor_cg_iterations", d.stale_factor_iterations},
+                    {"stale_factor_time", d.stale_factor_time},
+                    {"coupled_solves", d.n_coupled_solves},
+                    {"coupled_gmres_iterations", d.coupled_iterations},
+                    {"coupled_time", d.coupled_time}});
+    return figures;
   }
 } // namespace knee_contact

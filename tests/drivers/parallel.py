@@ -14,15 +14,17 @@
    to 1e-2 of the largest bar.
    The distributed iterative path (Contact/Solver = iterative: CG and AMG
    over the ranks, here to 1e-14 of the load: tight_krylov(); with 3D
-   friction its Newton springs) and the direct paths (whole on each rank)
-   both; adaptive refinement (3D, goal-oriented) and a 2D study of both
+   friction its Newton springs), the sparse path with MUMPS's factor over
+   the ranks (against CHOLMOD's of one process) and the condensed path
+   (whole on each rank); adaptive refinement (3D, goal-oriented) and a 2D study of both
    sequences. Measured: at most 1.2e-10 (the 3D knee at 2.3e5 dofs at
    1e-12: 1.1e-11, doc/parallel.md).
    Bodies moved along a frictional path (drivers/motion.py's 3D drag,
    Load cases/Motion) on the distributed iterative path.
 2. More ranks than cells on a body and than vertices: a block of one cell
-   on a base of 4 x 2 (19 vertices), 24 ranks, the iterative path (ranks
-   that own no row still take part in every collective operation).
+   on a base of 4 x 2 (19 vertices), 24 ranks, the iterative path and the
+   sparse path's MUMPS (ranks that own no row still take part in every
+   collective operation).
 3. Bad input under mpirun: exit code 1 and the one-line error printed once
    (not once per rank); also a .geo gmsh refuses (rank 0 alone runs gmsh,
    the others take its failure).
@@ -62,6 +64,14 @@ SCENES = [("contact_patch_3d_tet_iterative.prm", None, 2, []),
           ("knee_small.prm", None, 2, []),
           ("friction_sliding_block.prm", None, 2, []),
           ("friction_sliding_block_3d.prm", "iterative", 2,
+           [("9.5533; 2.9552; 0", "0.0095533; 0.0029552; 0"),
+            (r"\nsubsection Verification\n(.*\n)*?end\n", "\n")]),
+          # MUMPS's factor over the ranks (the sparse path's automatic
+          # factor on more than one rank) against CHOLMOD's of one
+          # process: a 2D knee, and the 3D block's Newton springs and
+          # Coulomb couplings (GMRES on the distributed factor).
+          ("knee_small.prm", "sparse", 2, []),
+          ("friction_sliding_block_3d.prm", "sparse", 2,
            [("9.5533; 2.9552; 0", "0.0095533; 0.0029552; 0"),
             (r"\nsubsection Verification\n(.*\n)*?end\n", "\n")]),
           ("load_cases_patch.prm", "iterative", 2, []),
@@ -314,6 +324,14 @@ def compare_runs(binary, folder, name, text, ranks, failures):
             failures.append("%s/%s: solver ranks %r, not %d" %
                             (name, path, summary["solver"].get("ranks"),
                              ranks))
+        # The sparse path on several ranks factorises with MUMPS over all
+        # of them (Contact/Direct factor = automatic).
+        if summary["solver"]["name"] == "sparse" and \
+                summary["solver"].get("mumps_ranks") != ranks:
+            failures.append("%s/%s: sparse path without MUMPS over %d "
+                            "ranks (%r)" % (name, path, ranks,
+                                            summary["solver"].get(
+                                                "mumps_ranks")))
     if not one or one.keys() != many.keys():
         failures.append("%s: summaries %s against %s" % (name, sorted(one),
                                                          sorted(many)))
@@ -381,6 +399,11 @@ def main():
                          scene_text(scene, solver, change, "@FOLDER@"), ranks,
                          failures)
         compare_runs(binary, folder, "one_cell_block", BLOCK, 24, failures)
+        # MUMPS with ranks that own no row of the matrix (38 dofs, 24
+        # ranks hold 1 or 2 each, some none after the constraints).
+        compare_runs(binary, folder, "one_cell_block_mumps",
+                     BLOCK.replace("set Solver = iterative",
+                                   "set Solver = sparse"), 24, failures)
         # Bodies moved along a frictional path (Load cases/Motion): the 3D
         # drag, hold, pull back and twist of drivers/motion.py on the
         # distributed iterative path (measured: 1e-15 of the energy). Left

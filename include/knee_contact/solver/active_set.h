@@ -174,6 +174,13 @@ namespace knee_contact
       return krylov;
     }
 
+    /** The sparse path's factor library (Contact/Direct factor). */
+    DirectFactor
+    direct_factor() const
+    {
+      return factor;
+    }
+
     /** Override the scene's Contact/Solver (tests compare the two). */
     void
     set_linear_solver(const LinearSolver linear_solver)
@@ -344,6 +351,7 @@ namespace knee_contact
     bool           reference_solve = false;
     unsigned int   coarse_levels   = 0;
     KrylovSettings krylov;
+    DirectFactor   factor = DirectFactor::automatic;
   };
 } // namespace knee_contact
 

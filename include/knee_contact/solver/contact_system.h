@@ -3,6 +3,7 @@
 
 #include <knee_contact/contact/contact_row.h>
 #include <knee_contact/physics/rigid_modes.h>
+#include <knee_contact/solver/sparse_factor.h>
 
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/sparse_matrix.h>
@@ -450,6 +451,14 @@ namespace knee_contact
     statistics() const override;
 
     /**
+     * Factorise with MUMPS, distributed over the ranks, instead of CHOLMOD
+     * on every rank whole (before the first solve; collective). CHOLMOD's
+     * analysis stays for the estimates.
+     */
+    void
+    use_mumps();
+
+    /**
      * The fill-reducing ordering of every dof (perm[new] = dof), which the
      * condensed path reuses.
      */
@@ -650,9 +659,10 @@ namespace knee_contact
    * fits in the memory available to the process (MemAvailable, the cgroup
    * limit, ulimit -v); a requested path that does not fit is switched, and
    * if none fits the run is refused in one line naming the estimate and
-   * the limit. @p warm_start: the loop starts from a guess (a refined
-   * mesh, a further load case), so fewer iterations are expected. @p log
-   * gets one line saying which path and why.
+   * the limit. @p factor: the sparse path's factor library (MUMPS's is
+   * divided over the ranks, in the estimates too). @p warm_start: the loop
+   * starts from a guess (a refined mesh, a further load case), so fewer
+   * iterations are expected. @p log gets one line saying which path and why.
    */
   SolverChoice
   make_contact_system(const SolverPath                 requested,
@@ -661,6 +671,7 @@ namespace knee_contact
                       const std::vector<ContactRow>   &pairs,
                       const RigidModeCheck            &rigid_modes,
                       const KrylovSettings            &krylov,
+                      const DirectFactor               factor,
                       const bool                       warm_start,
                       std::ostream                    &log);
 

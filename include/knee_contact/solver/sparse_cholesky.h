@@ -1,6 +1,8 @@
 #ifndef knee_contact_sparse_cholesky_h
 #define knee_contact_sparse_cholesky_h
 
+#include <knee_contact/solver/sparse_factor.h>
+
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/sparsity_pattern.h>
@@ -116,11 +118,11 @@ namespace knee_contact
      * a given order. analyse() once per pattern, then factorise() any
      * matrix of that pattern as often as needed.
      */
-    class SparseCholesky
+    class SparseCholesky : public SparseFactor
     {
     public:
       SparseCholesky();
-      ~SparseCholesky();
+      ~SparseCholesky() override;
       SparseCholesky(const SparseCholesky &) = delete;
       SparseCholesky &
       operator=(const SparseCholesky &) = delete;
@@ -155,7 +157,7 @@ namespace knee_contact
        * definite.
        */
       bool
-      factorise(const SparseMatrix<double> &a);
+      factorise(const SparseMatrix<double> &a) override;
 
       /** Frees CHOLMOD's copy of the matrix (kept for refactorisation). */
       void
@@ -183,11 +185,18 @@ namespace knee_contact
 
       /** Memory of the factor's values and row indices [MB]. */
       double
-      memory_MB() const;
+      memory_MB() const override;
 
       /** b = solve(system, b) for CHOLMOD_P, _L, _Lt, _Pt, _A. */
       void
       solve(const int system, std::vector<double> &b);
+
+      /** b = A^-1 b (CHOLMOD_A). */
+      void
+      solve(std::vector<double> &b) override
+      {
+        solve(CHOLMOD_A, b);
+      }
 
     private:
       void
