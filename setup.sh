@@ -13,10 +13,11 @@ cd "$(dirname "$0")"
 # zlib inflates compressed VTU meshes; meshio and VTK 9 (Python) write the
 # mesh files of other programs that the format tests read. The iterative
 # solver path calls Trilinos ML (libtrilinos-ml-dev) and initialises MPI
-# itself (mpi-default-dev); libdeal.ii-dev brings both, named here because
-# the code uses them directly.
+# itself (mpi-default-dev); the sparse path's distributed factor calls
+# MUMPS (libmumps-dev); libdeal.ii-dev brings all three, named here
+# because the code uses them directly.
 packages="cmake make g++ libdeal.ii-dev numdiff perl openmpi-bin gmsh
-          libtrilinos-ml-dev mpi-default-dev
+          libtrilinos-ml-dev mpi-default-dev libmumps-dev
           libopenblas0-pthread nlohmann-json3-dev python3-matplotlib
           libsuitesparse-dev libmetis-dev zlib1g-dev python3-meshio
           python3-vtk9"

@@ -1,10 +1,9 @@
 #include <knee_contact/base/interruption.h>
 #include <knee_contact/base/parallel.h>
 
-#include <deal.II/base/exceptions.h>
 #include <deal.II/base/multithread_info.h>
 
-#include <petscsys.h>
+#include <dlfcn.h>
 
 #include <algorithm>
 #include <chrono>
@@ -144,9 +143,19 @@ namespace knee_contact
       // still lowers it). With every rank on all cores, two ranks of the
       // 3D knee at 1.0e6 DoFs took 12.2 s for the assembly one process does
       // in 6.4 (2026-11-27).
+      // The same for OpenBLAS's threads, which MUMPS's and CHOLMOD's
+      // dense kernels run on (OPENBLAS_NUM_THREADS is read when the
+      // library loads, before this).
       if (size > 1)
-        dealii::MultithreadInfo::set_thread_limit(
-          std::max(1u, dealii::MultithreadInfo::n_cores() / size));
+        {
+          const unsigned int share =
+            std::max(1u, dealii::MultithreadInfo::n_cores() / size);
+          dealii::MultithreadInfo::set_thread_limit(share);
+          using set_threads = void (*)(int);
+          if (const auto set = reinterpret_cast<set_threads>(
+                dlsym(RTLD_DEFAULT, "openblas_set_num_threads")))
+            set(static_cast<int>(share));
+        }
       std::atexit([]() {
         int finalised = 0;
         MPI_Finalized(&finalised);
@@ -159,31 +168,6 @@ namespace knee_contact
             interruption::unregister_folder(session_folder);
           }
       });
-    }
-
-
-
-    void
-    ensure_petsc()
-    {
-      PetscBool initialised = PETSC_FALSE;
-      PetscInitialized(&initialised);
-      if (initialised)
-        return;
-      ensure_initialised();
-      // PETSc reads its options from the command line it is given: this
-      // one, not the program's (whose arguments are the scene's).
-      static char name[] = "knee_contact", no_handlers[] = "-no_signal_handler",
-                  no_files[]   = "-skip_petscrc";
-      static char *arguments[] = {name, no_handlers, no_files, nullptr};
-      int          argc        = 3;
-      char       **argv        = arguments;
-      PETSC_COMM_WORLD         = communicator();
-      AssertThrow(PetscInitialize(&argc, &argv, nullptr, nullptr) == 0,
-                  dealii::ExcMessage("PETSc could not be initialised"));
-      PetscPushErrorHandler(PetscReturnErrorHandler, nullptr);
-      // Registered after MPI's finalisation, so run before it.
-      std::atexit([]() { PetscFinalize(); });
     }
 
 

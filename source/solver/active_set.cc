@@ -80,7 +80,7 @@ namespace knee_contact
         {direct_factor_name(DirectFactor::cholmod), DirectFactor::cholmod},
         {direct_factor_name(DirectFactor::mumps), DirectFactor::mumps}},
       "The sparse path's factor. CHOLMOD: supernodal Cholesky, the whole "
-      "factor on every rank; MUMPS (through PETSc): multifrontal LDL^T "
+      "factor on every rank; MUMPS: multifrontal LDL^T in the same order "
       "with the factor and its work divided over the ranks of an mpirun "
       "(memory per rank about 1/N of the factor), and on one process the "
       "sparse path whatever the automatic choice (doc/parallel.md); "

@@ -240,13 +240,13 @@ namespace knee_contact
     // its factor holds the dense k x k trailing block.
     const double matrix_bytes =
       12. * nnz_lower + 12. * sparsity.n_nonzero_elements();
-    // MUMPS: its share of the factor on each rank, and PETSc's copy of
-    // the rank's rows of the matrix beside CHOLMOD's analysis.
-    const double sparse_bytes =
-      mumps ? 2 * 9.6 * lnz / factor_ranks +
-                (12. * sparsity.n_nonzero_elements() / factor_ranks +
-                 12. * sparsity.n_nonzero_elements())
-            : 2 * 9.6 * lnz + matrix_bytes;
+    // MUMPS: its share of the factor on each rank and of the matrix's
+    // upper triangle it is given (two indices and a value, 16 bytes an
+    // entry), beside the condensed copy (CHOLMOD keeps its analysis only).
+    const double sparse_bytes = mumps ? 2 * 9.6 * lnz / factor_ranks +
+                                          16. * nnz_lower / factor_ranks +
+                                          12. * sparsity.n_nonzero_elements()
+                                      : 2 * 9.6 * lnz + matrix_bytes;
     // With friction the Newton step on the bound adds, per tangential row,
     // its columns of W and G where it is not a loop row (2D: k + P) and at
     // most one coupled column of G per pair (P).

@@ -422,7 +422,7 @@ namespace knee_contact
     Implementation &d = *implementation;
     Assert(d.n_factorisations == 0, ExcInternalError());
     Timer clock;
-    d.distributed = make_mumps_factor(d.matrix.get_sparsity_pattern());
+    d.distributed = make_mumps_factor(d.matrix.get_sparsity_pattern(), d.order);
     // CHOLMOD keeps its analysis (the estimates), not its copy of C.
     d.cholesky.release_matrix();
     d.analysis += clock.wall_time();

@@ -33,16 +33,6 @@ namespace knee_contact
     void
     ensure_initialised();
 
-    /**
-     * Initialise PETSc once on parallel::communicator() (for MUMPS), after
-     * MPI, and finalise it at exit before MPI. PETSc installs no signal
-     * handlers (the run's own, interruption.h, end it cleanly), reads no
-     * .petscrc file (a run's options come from its scene) and prints no
-     * errors (each call's code becomes the caller's one-line message).
-     */
-    void
-    ensure_petsc();
-
     /** MPI_COMM_WORLD once initialised, else MPI_COMM_SELF. */
     MPI_Comm
     communicator();

@@ -181,6 +181,13 @@ namespace knee_contact
       return factor;
     }
 
+    /** Override the scene's Contact/Direct factor (tests compare them). */
+    void
+    set_direct_factor(const DirectFactor direct_factor)
+    {
+      factor = direct_factor;
+    }
+
     /** Override the scene's Contact/Solver (tests compare the two). */
     void
     set_linear_solver(const LinearSolver linear_solver)

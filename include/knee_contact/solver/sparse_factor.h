@@ -16,8 +16,8 @@ namespace knee_contact
   /**
    * Which library factorises the sparse path's matrix (Contact/Direct
    * factor): CHOLMOD's supernodal Cholesky, whole on every rank, or
-   * MUMPS's multifrontal LDL^T through PETSc, its factor distributed over
-   * the ranks; automatic takes MUMPS on more than one rank.
+   * MUMPS's multifrontal LDL^T, its factor distributed over the ranks;
+   * automatic takes MUMPS on more than one rank.
    */
   enum class DirectFactor
   {
@@ -77,13 +77,15 @@ namespace knee_contact
 
 
   /**
-   * MUMPS's factor through PETSc, distributed over the ranks of
-   * parallel::communicator() (rank r holds rows [r n / N, (r + 1) n / N)
-   * of the matrix and its share of the factor); made for the pattern of
-   * @p pattern. Collective.
+   * MUMPS's factor, distributed over the ranks of parallel::communicator()
+   * (rank r gives rows [r n / N, (r + 1) n / N) of the matrix and holds its
+   * share of the factor), for the pattern of @p pattern in the pivot order
+   * @p order (perm[position] = dof: the METIS order of CHOLMOD's
+   * analysis). Collective.
    */
   std::unique_ptr<SparseFactor>
-  make_mumps_factor(const SparsityPattern &pattern);
+  make_mumps_factor(const SparsityPattern  &pattern,
+                    const std::vector<int> &order);
 } // namespace knee_contact
 
 #endif
