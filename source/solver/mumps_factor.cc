@@ -199,7 +199,8 @@ namespace knee_contact
       // INFO(15): MUMPS's estimate of the memory this rank's factorisation
       // takes [MB]; INFOG(16) the largest over the ranks. Checked before
       // it allocates, against this rank's share of the machine.
-      estimated_MB = id.info[14];
+      // MUMPS counts in millions of bytes, summary.json in MiB.
+      estimated_MB = id.info[14] * 1e6 / 1048576.;
       // INFOG(20) counts in millions when negative (MUMPS's convention).
       factor_entries =
         id.infog[19] < 0 ? -1e6 * id.infog[19] : double(id.infog[19]);
@@ -240,7 +241,8 @@ namespace knee_contact
         return false;
       if (id.infog[0] < 0)
         call(job_factorise, "factorisation");
-      used_MB = id.info[21]; // INFO(22): memory this rank used [MB]
+      // INFO(22): the memory this rank used [millions of bytes].
+      used_MB = id.info[21] * 1e6 / 1048576.;
       // INFOG(12): negative pivots; INFOG(28): null pivots.
       return id.infog[11] == 0 && id.infog[27] == 0;
     }

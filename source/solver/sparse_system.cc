@@ -785,6 +785,7 @@ namespace knee_contact
                     {"solve_and_multipliers", d.solves},
                     {"factor_memory_MB", d.factor().memory_MB()},
                     {"factor_flops", d.cholesky.flops()},
+                    {"factor_entries", d.cholesky.nnz_factor()},
                     {"spring_sets", d.n_spring_sets},
                     {"stale_factor_solves", d.n_stale_factor_solves},
                     {"stale_factor_cg_iterations", d.stale_factor_iterations},
