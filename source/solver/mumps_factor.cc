@@ -42,7 +42,8 @@ namespace knee_contact
 
   namespace
   {
-    // MUMPS's arrays are 1-based, as its manual numbers them.
+    // MUMPS's phases (its JOB). Its control and information arrays are
+    // numbered from 1 in its manual: id.icntl[k - 1] is ICNTL(k).
     constexpr int job_initialise = -1, job_end = -2, job_analyse = 1,
                   job_factorise = 2, job_solve = 3;
 
@@ -179,8 +180,8 @@ namespace knee_contact
         return;
       // -8, -9, -11, -12, -13, -14, -15, -17, -19, -20: a workspace or
       // memory of MUMPS's; the rest its own diagnostics.
-      const bool memory = code == -8 || code == -9 || code == -13 ||
-                          code == -19 || (code <= -11 && code >= -20);
+      const bool memory =
+        code <= -8 && code >= -20 && code != -10 && code != -16 && code != -18;
       AssertThrow(false,
                   ExcMessage(std::string(memory ? "out of memory: " : "") +
                              "MUMPS's " + what +
