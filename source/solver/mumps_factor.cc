@@ -91,6 +91,10 @@ namespace knee_contact
       void
       call(const int job, const char *what);
 
+      /** MUMPS's last phase failed (INFOG(1) < 0): throw its line. */
+      void
+      check(const char *what) const;
+
       /** MUMPS's analysis in the given order; refuses a factor that would
        * not fit. */
       void
@@ -150,7 +154,13 @@ namespace knee_contact
       // ICNTL(24): null pivots detected, so that a singular matrix is
       // refused, not solved.
       id.icntl[23] = 1;
+      // One dense right hand side and its solution, whole on the host
+      // (ICNTL(20) = 0, ICNTL(21) = 0).
+      id.icntl[19] = 0;
+      id.icntl[20] = 0;
+      id.nrhs      = 1;
       id.n         = static_cast<MUMPS_INT>(n);
+      id.lrhs      = id.n;
       id.nnz_loc   = rows.size();
       id.irn_loc   = rows.data();
       id.jcn_loc   = columns.data();
@@ -175,6 +185,14 @@ namespace knee_contact
     {
       id.job = job;
       dmumps_c(&id);
+      check(what);
+    }
+
+
+
+    void
+    MumpsFactor::check(const char *what) const
+    {
       const int code = id.infog[0];
       if (code >= 0)
         return;
@@ -237,11 +255,10 @@ namespace knee_contact
       id.job = job_factorise;
       dmumps_c(&id);
       // -10: numerically singular, i.e. not definite here (the caller's
-      // message); any other failure is said by call()'s rule.
+      // message); any other failure is said by check().
       if (id.infog[0] == -10)
         return false;
-      if (id.infog[0] < 0)
-        call(job_factorise, "factorisation");
+      check("factorisation");
       // INFO(22): the memory this rank used [millions of bytes].
       used_MB = id.info[21] * 1e6 / 1048576.;
       // INFOG(12): negative pivots; INFOG(28): null pivots.
@@ -253,13 +270,9 @@ namespace knee_contact
     void
     MumpsFactor::solve(std::vector<double> &b)
     {
-      // Dense right hand side and solution on the host (ICNTL(20) = 0,
-      // ICNTL(21) = 0): b is whole on every rank already.
-      id.icntl[19] = 0;
-      id.icntl[20] = 0;
-      id.nrhs      = 1;
-      id.lrhs      = id.n;
-      id.rhs       = parallel::rank() == 0 ? b.data() : nullptr;
+      // b is whole on every rank; MUMPS reads and overwrites rank 0's
+      // (the constructor's ICNTL(20), ICNTL(21)).
+      id.rhs = parallel::rank() == 0 ? b.data() : nullptr;
       call(job_solve, "solve");
       MPI_Bcast(b.data(), static_cast<int>(b.size()), MPI_DOUBLE, 0, comm);
     }
