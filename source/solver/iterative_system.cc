@@ -368,10 +368,8 @@ namespace knee_contact
     IndexSet                       owned;
     AffineConstraints<double>      constraints;
     TrilinosWrappers::SparseMatrix amg_matrix;
-    /** Several ranks: the pattern of this rank's rows (every set's). */
+    /** The pattern of this rank's rows (every set's; owned_pattern()). */
     TrilinosWrappers::SparsityPattern trilinos_pattern;
-    /** Several ranks: this rank's rows of the condensed matrix. */
-    SparseMatrix<double> row_sums;
     /** Several ranks: this rank's rows of C. */
     TrilinosWrappers::SparseMatrix    distributed_matrix;
     TrilinosWrappers::PreconditionAMG amg;
@@ -425,6 +423,11 @@ namespace knee_contact
     copy_rows(const SparseMatrix<double>                 &from,
               TrilinosWrappers::SparseMatrix             &to,
               const std::vector<types::global_dof_index> &rows);
+
+    /** The stiffness matrix's pattern, this rank's rows, in Trilinos
+     * (made on the first call): it holds every set's condensed rows. */
+    const TrilinosWrappers::SparsityPattern &
+    owned_pattern();
 
     /** amg_matrix: the condensed matrix of the current set, this rank's
      * rows. */
@@ -588,26 +591,31 @@ namespace knee_contact
           amg_set_rows.push_back(row);
       }
 
-    if (row_sums.empty())
-      row_sums.reinit(matrix.get_sparsity_pattern());
-    for (const auto row : rows)
-      for (auto entry = row_sums.begin(row); entry != row_sums.end(row);
-           ++entry)
-        entry->value() = 0;
-    // C's row @p from with its constrained columns spread over their
-    // masters, once per row (a contact row has tens of masters, and
-    // spreading it for each one took 0.5 s a set-up at 1.25e5 dofs).
+    // Each row is summed once in a dense scratch row and written into
+    // Trilinos whole, on the pattern's columns (a deal.II matrix on the
+    // whole pattern for the sums, copied row by row, held 8 bytes per
+    // entry of C on every rank: 112 MB of the 3D knee's iterative path at
+    // 2.3e5 dofs).
     std::vector<double>                  row_of(n, 0.);
     std::vector<bool>                    in_row(n, false);
     std::vector<types::global_dof_index> columns;
-    const auto spread = [&](const types::global_dof_index from) {
+    const auto add = [&](const types::global_dof_index j, const double v) {
+      if (!in_row[j])
+        columns.push_back(j);
+      in_row[j] = true;
+      row_of[j] += v;
+    };
+    const auto clear = [&]() {
+      for (const auto j : columns)
+        {
+          row_of[j] = 0;
+          in_row[j] = false;
+        }
       columns.clear();
-      const auto add = [&](const types::global_dof_index j, const double v) {
-        if (!in_row[j])
-          columns.push_back(j);
-        in_row[j] = true;
-        row_of[j] += v;
-      };
+    };
+    // Adds C's row @p from, its constrained columns spread over their
+    // masters, to the scratch row.
+    const auto add_spread = [&](const types::global_dof_index from) {
       for (auto entry = matrix.begin(from); entry != matrix.end(from); ++entry)
         if (const auto *masters =
               constraints.get_constraint_entries(entry->column()))
@@ -616,44 +624,81 @@ namespace knee_contact
         else
           add(entry->column(), entry->value());
     };
-    // Adds @p weight times the spread row to row @p to.
-    const auto add_to = [&](const types::global_dof_index to,
-                            const double                  weight) {
-      for (const auto j : columns)
-        row_sums.add(to, j, weight * row_of[j]);
-    };
-    const auto clear = [&]() {
-      for (const auto j : columns)
-        {
-          row_of[j] = 0;
-          in_row[j] = false;
-        }
-    };
-    for (const auto row : rows)
-      if (constraints.is_constrained(row))
-        row_sums.set(row, row, matrix.diag_element(row));
-      else
-        {
-          spread(row);
-          add_to(row, 1.);
-          clear();
-        }
+    // The lines each row to make is a master of (with the weight), and
+    // those lines' spread rows, made once (a contact row has tens of
+    // masters: spreading it for each one took 0.5 s a set-up at 1.25e5
+    // dofs).
+    using Entries = std::vector<std::pair<types::global_dof_index, double>>;
+    std::map<types::global_dof_index, Entries> lines_of, spread_lines;
     for (const auto &line : constraints.get_lines())
+      for (const auto &[master, weight] : line.entries)
+        if (remake[master])
+          {
+            lines_of[master].emplace_back(line.index, weight);
+            auto [spread, is_new] = spread_lines.try_emplace(line.index);
+            if (is_new)
+              {
+                add_spread(line.index);
+                for (const auto j : columns)
+                  spread->second.emplace_back(j, row_of[j]);
+                clear();
+              }
+          }
+
+    if (amg_matrix.m() != n)
+      amg_matrix.reinit(owned_pattern());
+    const SparsityPattern &pattern = matrix.get_sparsity_pattern();
+    std::vector<types::global_dof_index> row_columns;
+    std::vector<double>                  values;
+    for (const auto row : rows)
       {
-        bool spread_yet = false;
-        for (const auto &[master, weight] : line.entries)
-          if (remake[master])
-            {
-              if (!spread_yet)
-                spread(line.index);
-              spread_yet = true;
-              add_to(master, weight);
-            }
-        if (spread_yet)
-          clear();
+        const bool constrained = constraints.is_constrained(row);
+        if (!constrained)
+          {
+            add_spread(row);
+            const auto found = lines_of.find(row);
+            if (found != lines_of.end())
+              for (const auto &[line, weight] : found->second)
+                for (const auto &[j, v] : spread_lines[line])
+                  add(j, weight * v);
+          }
+        row_columns.clear();
+        values.clear();
+        for (auto entry = pattern.begin(row); entry != pattern.end(row);
+             ++entry)
+          {
+            const auto j = entry->column();
+            row_columns.push_back(j);
+            values.push_back(constrained
+                               ? (j == row ? matrix.diag_element(row) : 0.)
+                               : row_of[j]);
+          }
+        amg_matrix.set(row,
+                       row_columns.size(),
+                       row_columns.data(),
+                       values.data());
+        clear();
       }
-    copy_rows(row_sums, amg_matrix, rows);
+    amg_matrix.compress(VectorOperation::insert);
     amg_filled = true;
+  }
+
+
+
+  const TrilinosWrappers::SparsityPattern &
+  IterativeContactSystem::Implementation::owned_pattern()
+  {
+    const SparsityPattern &pattern = matrix.get_sparsity_pattern();
+    if (trilinos_pattern.n_rows() != pattern.n_rows())
+      {
+        trilinos_pattern.reinit(owned, owned, parallel::communicator());
+        for (const auto row : owned)
+          for (auto entry = pattern.begin(row); entry != pattern.end(row);
+               ++entry)
+            trilinos_pattern.add(row, entry->column());
+        trilinos_pattern.compress();
+      }
+    return trilinos_pattern;
   }
 
 
@@ -664,18 +709,8 @@ namespace knee_contact
     TrilinosWrappers::SparseMatrix             &to,
     const std::vector<types::global_dof_index> &rows)
   {
-    const SparsityPattern &pattern = from.get_sparsity_pattern();
-    if (trilinos_pattern.n_rows() != pattern.n_rows())
-      {
-        trilinos_pattern.reinit(owned, owned, parallel::communicator());
-        for (const auto row : owned)
-          for (auto entry = pattern.begin(row); entry != pattern.end(row);
-               ++entry)
-            trilinos_pattern.add(row, entry->column());
-        trilinos_pattern.compress();
-      }
-    if (to.m() != pattern.n_rows())
-      to.reinit(trilinos_pattern);
+    if (to.m() != from.m())
+      to.reinit(owned_pattern());
     std::vector<types::global_dof_index> columns;
     std::vector<double>                  values;
     for (const auto row : rows)
@@ -1181,9 +1216,8 @@ namespace knee_contact
                                           const bool             friction)
   {
     const double n = pattern.n_rows(), nnz = pattern.n_nonzero_elements();
-    // A deal.II matrix on the whole pattern for the condensed rows it
-    // makes (8 bytes an entry, condense()), Trilinos' copy of this rank's
-    // condensed rows (values and column indices, 12 bytes an entry), the
+    // Trilinos' matrix of this rank's condensed rows (values and column
+    // indices, 12 bytes an entry; condense() sums each row once), the
     // hierarchy (about 10 bytes per fine entry measured with plain
     // aggregation: 150 MB for the knee's 1.48e7 entries); the null space
     // twice (ML's copy), the CG and operator vectors and the condensed
@@ -1193,6 +1227,6 @@ namespace knee_contact
     const double ranks = parallel::n_ranks();
     const double basis = friction ? 8. * gmres_basis * n / ranks : 0.;
     const double of_c  = ranks > 1 ? 12. : 0.;
-    return 8. * nnz + (12. + 10. + of_c) * nnz / ranks + 8. * 22 * n + basis;
+    return (12. + 10. + of_c) * nnz / ranks + 8. * 22 * n + basis;
   }
 } // namespace knee_contact
