@@ -2,6 +2,7 @@
 // refinement cycle (ContactProblem's orchestration, split from problem.cc
 // by job as ASPECT splits its Simulator).
 #include <knee_contact/base/input.h>
+#include <knee_contact/base/parallel.h>
 #include <knee_contact/base/progress.h>
 #include <knee_contact/core/problem.h>
 #include <knee_contact/core/scene_checks.h>
@@ -411,6 +412,18 @@ namespace knee_contact
             contact_system = std::move(choice.system);
             solver_name    = std::move(choice.name);
             solver_figures = std::move(choice.figures);
+            // On several ranks the iterative path keeps its ranks' rows
+            // of C and the rows of the contact and constrained dofs: the
+            // whole matrix is released until the next assembly (8 bytes
+            // per entry on every rank; the pattern stays).
+            if (auto *iterative =
+                  dynamic_cast<IterativeContactSystem *>(contact_system.get());
+                iterative != nullptr && parallel::n_ranks() > 1)
+              {
+                const double MB = system_matrix.memory_consumption() / 1048576.;
+                system_matrix.clear();
+                iterative->matrix_released(MB);
+              }
           }
         if (!contact_pairs.frictional())
           {
@@ -648,9 +661,18 @@ namespace knee_contact
   ProblemAccess<dim>
   ContactProblem<dim>::access() const
   {
+    // C's product: the matrix's, or the iterative path's once the matrix
+    // was released (solve_contact()).
+    const auto product = [this](Vector<double> &y, const Vector<double> &x) {
+      if (!system_matrix.empty())
+        system_matrix.vmult(y, x);
+      else
+        dynamic_cast<const IterativeContactSystem &>(*contact_system)
+          .stiffness_product(y, x);
+    };
     return {dof_handler,
             body_of_cell,
-            system_matrix,
+            product,
             system_rhs,
             displacement,
             materials,

@@ -131,7 +131,7 @@ namespace knee_contact
         // exact tetrahedral block refined to 1 626 or 1 591 cells with one
         // or two BLAS threads).
         Vector<double> product(state.solution.size());
-        state.matrix.vmult(product, state.solution);
+        state.stiffness_product(product, state.solution);
         const double energy = state.solution * product;
         if (!(kelly.l2_norm() > round_off_level * std::sqrt(energy)))
           return false;

@@ -20,7 +20,7 @@ namespace knee_contact
   {
     const auto &[dof_handler,
                  body_of_cell,
-                 matrix,
+                 stiffness_product,
                  rhs,
                  solution,
                  materials,
@@ -40,8 +40,9 @@ namespace knee_contact
     // The force each dof's vertex receives from its supports: the
     // residual d - C x of the unconstrained system minus the contact forces
     // A^T lambda, with the sign of a reaction (C x = d + R - A^T lambda).
-    Vector<double> support_force(dof_handler.n_dofs());
-    matrix.vmult(support_force, solution);
+    Vector<double> product(dof_handler.n_dofs());
+    stiffness_product(product, solution);
+    Vector<double> support_force = product;
     support_force -= rhs;
     for (unsigned int p = 0; p < pairs.size(); ++p)
       for (const auto &[dof, a] : pairs.rows[p].row)
@@ -67,13 +68,9 @@ namespace knee_contact
     // a(u,u) = x^T C x, summed in a fixed order: SparseMatrix's own
     // matrix_norm_square() is a threaded reduction whose last bit varies
     // from run to run.
-    {
-      Vector<double> product(solution.size());
-      matrix.vmult(product, solution);
-      results.energy = 0;
-      for (unsigned int i = 0; i < solution.size(); ++i)
-        results.energy += solution(i) * product(i);
-    }
+    results.energy = 0;
+    for (unsigned int i = 0; i < solution.size(); ++i)
+      results.energy += solution(i) * product(i);
     results.max_displacement = solution.linfty_norm();
 
     // Applied load and reactions by vertex, each vertex once.

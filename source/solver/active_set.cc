@@ -302,7 +302,7 @@ namespace knee_contact
 
   void
   ActiveSetSolver::excess_and_multipliers(
-    const SparseMatrix<double>      &matrix,
+    const StiffnessResidual         &stiffness_residual,
     const Vector<double>            &rhs,
     const Vector<double>            &x,
     const AffineConstraints<double> &base,
@@ -314,7 +314,7 @@ namespace knee_contact
     const RowMultipliers            *coupled)
   {
     Vector<double> residual(rhs.size());
-    matrix.residual(residual, x, rhs);
+    stiffness_residual(residual, x, rhs);
     springs::add_forces(springs, x, residual);
     lambda = coupled != nullptr ? (*coupled)(residual)
                                 : RowMultipliers(base, pairs, active)(residual);

@@ -593,7 +593,8 @@ namespace knee_contact
   {
     Implementation &d = *implementation;
     Timer           clock;
-    const auto      b = sparse_cholesky::condense(d.matrix, rhs, d.base);
+    const auto      b =
+      sparse_cholesky::condense(residual_of(d.matrix), rhs, d.base);
     // y = L^-1 P b; with L = [L_ii 0; L_ci L_cc], f = b_c - C_ci C_ii^-1 b_i
     // = L_cc y_c.
     d.forward.assign(b.begin(), b.end());
@@ -925,9 +926,10 @@ namespace knee_contact
   {
     AffineConstraints<double> constraints;
     ActiveSetSolver::make_constraints(base, pairs, active, constraints);
-    Timer          clock;
-    const auto     a     = sparse_cholesky::condense(matrix, constraints);
-    const auto     b     = sparse_cholesky::condense(matrix, rhs, constraints);
+    Timer      clock;
+    const auto a = sparse_cholesky::condense(matrix, constraints);
+    const auto b =
+      sparse_cholesky::condense(residual_of(matrix), rhs, constraints);
     const auto     order = sparse_cholesky::fill_reducing_ordering(a, {});
     SparseCholesky cholesky;
     cholesky.analyse(a, order, true);

@@ -53,7 +53,7 @@ namespace knee_contact
     constraints.distribute(x);
 
     ActiveSetSolver::excess_and_multipliers(
-      matrix, *rhs, x, base, pairs, active, excess, lambda, terms);
+      residual_of(matrix), *rhs, x, base, pairs, active, excess, lambda, terms);
   }
 
 

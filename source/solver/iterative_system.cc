@@ -291,6 +291,8 @@ namespace knee_contact
                    const unsigned int                 components,
                    const KrylovSettings              &settings)
       : matrix(matrix)
+      , pattern(matrix.get_sparsity_pattern())
+      , n(matrix.m())
       , base(base)
       , pairs(pairs)
       , components(components)
@@ -301,11 +303,10 @@ namespace knee_contact
       // METIS partition of the vertex graph made on rank 0 (a contiguous
       // block of gmsh's cell-by-cell numbering scattered over the bodies:
       // the 3D knee at 2.3e5 dofs took twice the CG iterations of one
-      // rank). Every rank holds the whole stiffness matrix and rows (the
-      // replicated first stage of the parallel run, doc/parallel.md); the
-      // condensed matrix, the hierarchy and the Krylov vectors are
+      // rank). Every rank holds the rows (the replicated first stage of the
+      // parallel run, doc/parallel.md); C (after the constructor: rows_of_c()),
+      // the condensed matrix, the hierarchy and the Krylov vectors are
       // distributed.
-      const types::global_dof_index n = matrix.m();
       const unsigned int ranks = parallel::n_ranks(), rank = parallel::rank();
       owned.set_size(n);
       if (ranks == 1 || n % components != 0)
@@ -318,7 +319,6 @@ namespace knee_contact
           if (rank == 0)
             {
               DynamicSparsityPattern graph(n_blocks, n_blocks);
-              const SparsityPattern &pattern = matrix.get_sparsity_pattern();
               for (types::global_dof_index i = 0; i < n; i += components)
                 for (auto entry = pattern.begin(i); entry != pattern.end(i);
                      ++entry)
@@ -342,9 +342,15 @@ namespace knee_contact
                   modes[k].end(),
                   null_space.begin() + k * matrix.m());
       n_modes = modes.size();
+      if (ranks > 1)
+        keep_rows_of_c();
     }
 
+    /** C whole: on one rank the path's; on several only until the
+     * constructor has taken its rows (the problem may release it then). */
     const SparseMatrix<double>      &matrix;
+    const SparsityPattern           &pattern;
+    const types::global_dof_index    n;
     const AffineConstraints<double> &base;
     const std::vector<ContactRow>   &pairs;
     const unsigned int               components;
@@ -371,7 +377,13 @@ namespace knee_contact
     /** The pattern of this rank's rows (every set's; owned_pattern()). */
     TrilinosWrappers::SparsityPattern trilinos_pattern;
     /** Several ranks: this rank's rows of C. */
-    TrilinosWrappers::SparseMatrix    distributed_matrix;
+    TrilinosWrappers::SparseMatrix distributed_matrix;
+    /** Several ranks: C's rows of every dof a line can hold (the base's
+     * lines, the dofs of the contact rows; their masters' rows are
+     * owned or in it), on a pattern with no other rows. */
+    std::vector<bool>                 of_line;
+    SparsityPattern                   line_rows_pattern;
+    SparseMatrix<double>              line_rows;
     TrilinosWrappers::PreconditionAMG amg;
     bool                              has_amg = false;
     /** The set the hierarchy was built for, and the dofs its tied
@@ -423,6 +435,30 @@ namespace knee_contact
     copy_rows(const SparseMatrix<double>                 &from,
               TrilinosWrappers::SparseMatrix             &to,
               const std::vector<types::global_dof_index> &rows);
+
+    /** Several ranks: this rank's rows of C into distributed_matrix and
+     * the rows of every dof a line can hold into line_rows, so that C
+     * itself is no longer read. */
+    void
+    keep_rows_of_c();
+
+    /** The deal.II matrix holding C's rows of the lines (and their
+     * diagonals): C on one rank, line_rows on several. */
+    const SparseMatrix<double> &
+    rows_of_c() const
+    {
+      return parallel::n_ranks() == 1 ? matrix : line_rows;
+    }
+
+    /** Calls @p f(column, value) for each entry of C's row @p row (an
+     * owned row or a line's). */
+    template <typename Function>
+    void
+    for_each_in_row(const types::global_dof_index row, const Function &f) const;
+
+    /** y = C x (whole on every rank). */
+    void
+    product(Vector<double> &y, const Vector<double> &x) const;
 
     /** The stiffness matrix's pattern, this rank's rows, in Trilinos
      * (made on the first call): it holds every set's condensed rows. */
@@ -480,7 +516,7 @@ namespace knee_contact
     condense();
     // This rank's part of the null space, zero on the constrained dofs:
     // their rows are decoupled.
-    const types::global_dof_index n = matrix.m(), n_local = owned.n_elements();
+    const types::global_dof_index n_local = owned.n_elements();
     modes.assign(n_modes * n_local, 0.);
     for (unsigned int k = 0; k < n_modes; ++k)
       {
@@ -555,8 +591,7 @@ namespace knee_contact
     // among these. The last set's rows are made again too (to drop what
     // it added); every other row is the base's condensation, the same for
     // every set.
-    const types::global_dof_index n = matrix.m();
-    std::vector<bool>             of_set(n, false);
+    std::vector<bool> of_set(n, false);
     for (const auto &line : constraints.get_lines())
       {
         const auto *in_base = base.get_constraint_entries(line.index);
@@ -565,10 +600,10 @@ namespace knee_contact
         of_set[line.index] = true;
         for (const auto &[master, weight] : line.entries)
           of_set[master] = true;
-        for (auto entry = matrix.begin(line.index);
-             entry != matrix.end(line.index);
-             ++entry)
-          of_set[entry->column()] = true;
+        for_each_in_row(line.index,
+                        [&](const types::global_dof_index j, const double) {
+                          of_set[j] = true;
+                        });
       }
     for (const auto &line : constraints.get_lines())
       if (of_set[line.index])
@@ -616,13 +651,15 @@ namespace knee_contact
     // Adds C's row @p from, its constrained columns spread over their
     // masters, to the scratch row.
     const auto add_spread = [&](const types::global_dof_index from) {
-      for (auto entry = matrix.begin(from); entry != matrix.end(from); ++entry)
-        if (const auto *masters =
-              constraints.get_constraint_entries(entry->column()))
-          for (const auto &[master, w] : *masters)
-            add(master, w * entry->value());
-        else
-          add(entry->column(), entry->value());
+      for_each_in_row(from,
+                      [&](const types::global_dof_index j, const double v) {
+                        if (const auto *masters =
+                              constraints.get_constraint_entries(j))
+                          for (const auto &[master, w] : *masters)
+                            add(master, w * v);
+                        else
+                          add(j, v);
+                      });
     };
     // The lines each row to make is a master of (with the weight), and
     // those lines' spread rows, made once (a contact row has tens of
@@ -647,7 +684,6 @@ namespace knee_contact
 
     if (amg_matrix.m() != n)
       amg_matrix.reinit(owned_pattern());
-    const SparsityPattern &pattern = matrix.get_sparsity_pattern();
     std::vector<types::global_dof_index> row_columns;
     std::vector<double>                  values;
     for (const auto row : rows)
@@ -670,7 +706,7 @@ namespace knee_contact
             const auto j = entry->column();
             row_columns.push_back(j);
             values.push_back(constrained
-                               ? (j == row ? matrix.diag_element(row) : 0.)
+                               ? (j == row ? rows_of_c().diag_element(row) : 0.)
                                : row_of[j]);
           }
         amg_matrix.set(row,
@@ -688,7 +724,6 @@ namespace knee_contact
   const TrilinosWrappers::SparsityPattern &
   IterativeContactSystem::Implementation::owned_pattern()
   {
-    const SparsityPattern &pattern = matrix.get_sparsity_pattern();
     if (trilinos_pattern.n_rows() != pattern.n_rows())
       {
         trilinos_pattern.reinit(owned, owned, parallel::communicator());
@@ -699,6 +734,97 @@ namespace knee_contact
         trilinos_pattern.compress();
       }
     return trilinos_pattern;
+  }
+
+
+
+  void
+  IterativeContactSystem::Implementation::keep_rows_of_c()
+  {
+    copy_rows(matrix,
+              distributed_matrix,
+              std::vector<types::global_dof_index>(owned.begin(), owned.end()));
+    // The dofs a line can hold: the base's lines and every dof of a
+    // contact row (a row eliminates one of its own dofs; so does a tied
+    // spring, whose dofs are its rows'). O(surface) rows.
+    of_line.assign(n, false);
+    for (const auto &line : base.get_lines())
+      of_line[line.index] = true;
+    for (const auto &row : pairs)
+      {
+        for (const auto &[j, a] : row.row)
+          of_line[j] = true;
+        for (const auto &[j, a] : row.reduced_row)
+          of_line[j] = true;
+      }
+    std::vector<unsigned int> lengths(n, 1);
+    for (types::global_dof_index i = 0; i < n; ++i)
+      if (of_line[i])
+        lengths[i] = pattern.row_length(i);
+    line_rows_pattern.reinit(n, n, lengths);
+    for (types::global_dof_index i = 0; i < n; ++i)
+      if (of_line[i])
+        for (auto entry = pattern.begin(i); entry != pattern.end(i); ++entry)
+          line_rows_pattern.add(i, entry->column());
+    line_rows_pattern.compress();
+    line_rows.reinit(line_rows_pattern);
+    for (types::global_dof_index i = 0; i < n; ++i)
+      if (of_line[i])
+        for (auto entry = matrix.begin(i); entry != matrix.end(i); ++entry)
+          line_rows.set(i, entry->column(), entry->value());
+  }
+
+
+
+  template <typename Function>
+  void
+  IterativeContactSystem::Implementation::for_each_in_row(
+    const types::global_dof_index row,
+    const Function               &f) const
+  {
+    const SparseMatrix<double> &rows = rows_of_c();
+    if (parallel::n_ranks() == 1 || of_line[row])
+      {
+        for (auto entry = rows.begin(row); entry != rows.end(row); ++entry)
+          f(entry->column(), entry->value());
+        return;
+      }
+    // An owned row: Epetra's own view of it (deal.II's iterators over a
+    // Trilinos matrix copy each row they visit).
+    const Epetra_CrsMatrix &epetra = distributed_matrix.trilinos_matrix();
+    const int               local =
+      epetra.RowMap().LID(TrilinosWrappers::types::int_type(row));
+    AssertThrow(local >= 0, ExcInternalError());
+    int     length  = 0;
+    double *values  = nullptr;
+    int    *columns = nullptr;
+    epetra.ExtractMyRowView(local, length, values, columns);
+    for (int k = 0; k < length; ++k)
+      f(types::global_dof_index(epetra.ColMap().GID(columns[k])), values[k]);
+  }
+
+
+
+  void
+  IterativeContactSystem::Implementation::product(Vector<double>       &y,
+                                                  const Vector<double> &x) const
+  {
+    if (parallel::n_ranks() == 1)
+      {
+        matrix.vmult(y, x);
+        return;
+      }
+    // This rank's rows, then every rank takes the whole product.
+    const MPI_Comm                comm = parallel::communicator();
+    TrilinosWrappers::MPI::Vector from(owned, comm), to(owned, comm);
+    {
+      // By local index (a global one is a search in the partition's map).
+      Epetra_FEVector &entries = from.trilinos_vector();
+      for (int k = 0; k < entries.Map().NumMyElements(); ++k)
+        entries[0][k] = x(entries.Map().GID(k));
+    }
+    distributed_matrix.vmult(to, from);
+    y = Vector<double>(to);
   }
 
 
@@ -792,11 +918,6 @@ namespace knee_contact
       }
 
     // Several ranks: the matrix of this set is never formed.
-    if (distributed_matrix.m() != matrix.m())
-      copy_rows(matrix,
-                distributed_matrix,
-                std::vector<types::global_dof_index>(owned.begin(),
-                                                     owned.end()));
     const iterative::DistributedCondensedOperator operation(
       distributed_matrix, constraints, owned, operator_springs, *coupling);
     const MPI_Comm                comm = parallel::communicator();
@@ -842,9 +963,11 @@ namespace knee_contact
     const KrylovSettings              &settings)
   {
     parallel::ensure_initialised();
-    implementation = std::make_unique<Implementation>(
+    // (Before the implementation: on several ranks it copies its rows of C.)
+    const double resident = iterative::resident_MB();
+    implementation        = std::make_unique<Implementation>(
       matrix, base, pairs, modes, components, settings);
-    implementation->resident_at_start = iterative::resident_MB();
+    implementation->resident_at_start = resident;
   }
 
 
@@ -874,7 +997,7 @@ namespace knee_contact
   void
   IterativeContactSystem::start_from(const Vector<double> &x)
   {
-    AssertThrow(x.size() == implementation->matrix.m(), ExcInternalError());
+    AssertThrow(x.size() == implementation->n, ExcInternalError());
     implementation->x = x;
   }
 
@@ -913,7 +1036,7 @@ namespace knee_contact
     // the Newton iterations of the sparse path (13 and 11); at 0.01 x the
     // first took 15.
     springs::Ties ties = springs::tie_stiff(
-      d.given_springs, d.springs, d.pairs, active, d.matrix, 1.);
+      d.given_springs, d.springs, d.pairs, active, d.rows_of_c(), 1.);
     std::vector<ContactRow>        extended;
     const std::vector<ContactRow> *rows = &d.pairs;
     std::vector<bool>              held = active;
@@ -939,8 +1062,13 @@ namespace knee_contact
       *rows,
       d.couplings.empty() ? std::vector<bool>(rows->size(), false) : held,
       d.couplings);
+    const StiffnessResidual residual =
+      [&](Vector<double> &r, const Vector<double> &u, const Vector<double> &f) {
+        d.product(r, u);
+        r.sadd(-1., 1., f);
+      };
     const Vector<double> b = springs::condensed_load(d.operator_springs,
-                                                     d.matrix,
+                                                     residual,
                                                      *d.rhs,
                                                      d.constraints,
                                                      [&](Vector<double> &r) {
@@ -1108,7 +1236,7 @@ namespace knee_contact
       std::copy(ties.for_multipliers.begin(),
                 ties.for_multipliers.end(),
                 extended.begin() + d.pairs.size());
-    ActiveSetSolver::excess_and_multipliers(d.matrix,
+    ActiveSetSolver::excess_and_multipliers(residual,
                                             *d.rhs,
                                             d.x,
                                             d.base,
@@ -1169,6 +1297,23 @@ namespace knee_contact
     d.accuracy_of_start    = was_of_start;
     d.totals               = kept_totals;
     return time;
+  }
+
+
+
+  void
+  IterativeContactSystem::matrix_released(const double MB)
+  {
+    implementation->resident_at_start -= MB;
+  }
+
+
+
+  void
+  IterativeContactSystem::stiffness_product(Vector<double>       &y,
+                                            const Vector<double> &x) const
+  {
+    implementation->product(y, x);
   }
 
 

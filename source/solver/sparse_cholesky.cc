@@ -56,7 +56,7 @@ namespace knee_contact
 
 
     Vector<double>
-    condense(const SparseMatrix<double>      &matrix,
+    condense(const StiffnessResidual         &residual,
              const Vector<double>            &rhs,
              const AffineConstraints<double> &constraints)
     {
@@ -64,7 +64,7 @@ namespace knee_contact
       for (const auto &line : constraints.get_lines())
         g(line.index) = line.inhomogeneity;
       Vector<double> b(rhs.size());
-      matrix.residual(b, g, rhs);
+      residual(b, g, rhs);
       for (const auto &line : constraints.get_lines())
         for (const auto &[j, c] : line.entries)
           b(j) += c * b(line.index);

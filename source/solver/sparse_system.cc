@@ -535,7 +535,7 @@ namespace knee_contact
     // the excess of the solution.
     const auto report = [&](const RowMultipliers *coupled) {
       Timer clock;
-      ActiveSetSolver::excess_and_multipliers(d.matrix,
+      ActiveSetSolver::excess_and_multipliers(residual_of(d.matrix),
                                               *d.rhs,
                                               d.x,
                                               d.base,
@@ -555,10 +555,13 @@ namespace knee_contact
           d.factorise(active);
         const RowMultipliers coupling(d.base, d.pairs, active, d.couplings);
         Timer                clock;
-        const auto           b = springs::condensed_load(
-          d.springs, d.matrix, *d.rhs, d.constraints, [&](Vector<double> &r) {
-            coupling.project(r);
-          });
+        const auto           b = springs::condensed_load(d.springs,
+                                               residual_of(d.matrix),
+                                               *d.rhs,
+                                               d.constraints,
+                                               [&](Vector<double> &r) {
+                                                 coupling.project(r);
+                                               });
         // From the factor's solution; within what half a factorisation
         // costs (as with stale springs alone), else on a factor of the
         // springs set now.
@@ -600,9 +603,11 @@ namespace knee_contact
     const auto solve_base = [&]() {
       if (d.base_solved)
         return;
-      const auto b =
-        springs::condensed_load(d.springs, d.matrix, *d.rhs, d.constraints);
-      bool solved = false;
+      const auto b      = springs::condensed_load(d.springs,
+                                             residual_of(d.matrix),
+                                             *d.rhs,
+                                             d.constraints);
+      bool       solved = false;
       if (stale())
         {
           // From the last solution's free part.

@@ -91,22 +91,22 @@ namespace knee_contact
 
     Vector<double>
     condensed_load(const std::vector<SpringTerm>               &springs,
-                   const SparseMatrix<double>                  &matrix,
+                   const StiffnessResidual                     &residual,
                    const Vector<double>                        &rhs,
                    const AffineConstraints<double>             &constraints,
                    const std::function<void(Vector<double> &)> &before_folding)
     {
       if (springs.empty() && !before_folding)
-        return sparse_cholesky::condense(matrix, rhs, constraints);
+        return sparse_cholesky::condense(residual, rhs, constraints);
       Vector<double> g(rhs.size()), load = rhs;
       constraints.distribute(g);
       add_forces(springs, g, load);
       if (!before_folding)
-        return sparse_cholesky::condense(matrix, load, constraints);
+        return sparse_cholesky::condense(residual, load, constraints);
       // (distribute() gave g on the constrained dofs: the masters are
       // free, zero.)
       Vector<double> b(rhs.size());
-      matrix.residual(b, g, load);
+      residual(b, g, load);
       before_folding(b);
       sparse_cholesky::condense_homogeneous(constraints, b);
       return b;

@@ -6,11 +6,11 @@
 #include <knee_contact/physics/materials.h>
 #include <knee_contact/solver/active_set.h>
 
-#include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/vector.h>
 
 #include <deal.II/dofs/dof_handler.h>
 
+#include <functional>
 #include <vector>
 
 namespace knee_contact
@@ -36,8 +36,10 @@ namespace knee_contact
     const DoFHandler<dim> &dof_handler;
     /** The body (0, 1, ...) of each active cell, by active cell index. */
     const std::vector<unsigned int> &body_of_cell;
-    /** C and d of the unconstrained system. */
-    const SparseMatrix<double>    &matrix;
+    /** y = C x and d of the unconstrained system (C's product: on several
+     * ranks the iterative path holds C's rows, no rank the whole matrix). */
+    const std::function<void(Vector<double> &y, const Vector<double> &x)>
+                                   stiffness_product;
     const Vector<double>          &rhs;
     const Vector<double>          &solution;
     const Materials<dim>          &materials;

@@ -6,6 +6,7 @@
 #include <knee_contact/solver/contact_system.h>
 #include <knee_contact/solver/row_multipliers.h>
 #include <knee_contact/solver/springs.h>
+#include <knee_contact/solver/stiffness.h>
 
 #include <deal.II/base/parameter_handler.h>
 
@@ -320,13 +321,14 @@ namespace knee_contact
 
     /**
      * What a path that solves for the whole x reports (step-41, sparse):
-     * the multipliers from the residual d - C x (multipliers()), less the
+     * the multipliers from the residual d - C x (multipliers(); C through
+     * @p residual), less the
      * forces of the @p springs set, and the excess (A x - g)_p of every
      * pair from its jump; with @p coupled those of the coupled system
      * (the RowMultipliers the solve made, not made twice).
      */
     static void
-    excess_and_multipliers(const SparseMatrix<double>      &matrix,
+    excess_and_multipliers(const StiffnessResidual         &residual,
                            const Vector<double>            &rhs,
                            const Vector<double>            &x,
                            const AffineConstraints<double> &base,

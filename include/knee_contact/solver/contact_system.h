@@ -597,6 +597,22 @@ namespace knee_contact
     reference_solve(const std::vector<bool> &active, Vector<double> &x);
 
     /**
+     * y = C x, whole on every rank: on several ranks the stiffness matrix
+     * given to the constructor is no longer read once it is made (its
+     * rows are this path's), and its holder may release it.
+     */
+    void
+    stiffness_product(Vector<double> &y, const Vector<double> &x) const;
+
+    /**
+     * The holder released @p MB of the matrix after making this path: its
+     * measured memory (iterative_memory_MB, the resident growth by its
+     * first solve) counts them back.
+     */
+    void
+    matrix_released(const double MB);
+
+    /**
      * Peak memory [bytes] the path adds to the stiffness matrix, from the
      * pattern: the condensed copy while it is handed over, Trilinos' matrix,
      * the hierarchy and the Krylov vectors (measured: doc/performance.md);

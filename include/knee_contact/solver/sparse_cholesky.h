@@ -2,6 +2,7 @@
 #define knee_contact_sparse_cholesky_h
 
 #include <knee_contact/solver/sparse_factor.h>
+#include <knee_contact/solver/stiffness.h>
 
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/sparse_matrix.h>
@@ -63,10 +64,10 @@ namespace knee_contact
      * C0^T (d - C g) on the free dofs, zero on the constrained ones: the
      * right hand side of the condensed system for inhomogeneous lines
      * x_i = sum_j c_ij x_j + g_i (AffineConstraints condenses a vector
-     * only for homogeneous lines).
+     * only for homogeneous lines); d - C g from @p residual.
      */
     Vector<double>
-    condense(const SparseMatrix<double>      &matrix,
+    condense(const StiffnessResidual         &residual,
              const Vector<double>            &rhs,
              const AffineConstraints<double> &constraints);
 

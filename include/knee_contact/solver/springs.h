@@ -3,6 +3,7 @@
 
 #include <knee_contact/contact/contact_row.h>
 #include <knee_contact/solver/contact_system.h>
+#include <knee_contact/solver/stiffness.h>
 
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/sparse_matrix.h>
@@ -69,7 +70,8 @@ namespace knee_contact
                Vector<double>                &v);
 
     /**
-     * The condensed load of K x = d + sum k g_w w under @p constraints:
+     * The condensed load of K x = d + sum k g_w w under @p constraints (C
+     * through @p residual):
      * T^T (d + sum k g_w w - K g), g the constraints' inhomogeneities
      * (sparse_cholesky::condense() with the springs' forces at g);
      * @p before_folding, if given, changes the whole vector
@@ -79,7 +81,7 @@ namespace knee_contact
     Vector<double>
     condensed_load(
       const std::vector<SpringTerm>               &springs,
-      const SparseMatrix<double>                  &matrix,
+      const StiffnessResidual                     &residual,
       const Vector<double>                        &rhs,
       const AffineConstraints<double>             &constraints,
       const std::function<void(Vector<double> &)> &before_folding = {});
