@@ -348,7 +348,10 @@ namespace knee_contact
                                            sparsity_pattern,
                                            contact_pairs.frictional(),
                                            spring_rows);
-    system_matrix.reinit(sparsity_pattern);
+    // C is made by assemble_system(), whole or as the solver path's rows.
+    system_matrix.clear();
+    rigid_modes =
+      std::make_unique<RigidModes<dim>>(dof_handler, body_of_cell, body_names);
   }
 
 

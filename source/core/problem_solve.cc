@@ -107,10 +107,8 @@ namespace knee_contact
                   << dof_handler.n_dofs() << " dofs, " << n_bodies
                   << " bodies, " << contact_pairs.size() << " contact pairs"
                   << std::endl;
-        timed("assembly", [&]() {
-          ElasticityAssembler<dim> assembler(materials, boundary_conditions);
-          assembler.assemble(dof_handler, system_matrix, system_rhs);
-        });
+        timed("assembly",
+              [&]() { assemble_system(!previous_contact.empty()); });
         timed("solve", [&]() {
           // Warm start on a refined mesh: pairs within the previous contact
           // zone start active (the loop corrects the guess).
@@ -349,8 +347,7 @@ namespace knee_contact
           {
             make_mesh(level);
             setup_system();
-            ElasticityAssembler<dim> assembler(materials, boundary_conditions);
-            assembler.assemble(dof_handler, system_matrix, system_rhs);
+            assemble_system(!previous_contact.empty());
             solve_contact(previous_zone_guess(), true);
           }
         catch (const std::exception &exc)
@@ -380,8 +377,8 @@ namespace knee_contact
                                      const bool               new_matrix,
                                      const bool               continue_path)
   {
-    const RigidModes<dim> rigid_modes(dof_handler, body_of_cell, body_names);
-    std::ostream         &loop_log = contact_pairs.empty() ? quiet : std::cout;
+    const RigidModes<dim> &rigid_modes = *this->rigid_modes;
+    std::ostream          &loop_log = contact_pairs.empty() ? quiet : std::cout;
     try
       {
         Timer clock;
@@ -396,35 +393,10 @@ namespace knee_contact
             hold_tangential_rows_at(displacement);
             contact_system->gaps_changed();
           }
-        if (new_matrix)
-          {
-            contact_system.reset();
-            SolverChoice choice =
-              make_contact_system(active_set_solver.linear_solver(),
-                                  system_matrix,
-                                  constraints,
-                                  rows_for_solver(),
-                                  rigid_modes,
-                                  active_set_solver.krylov_settings(),
-                                  active_set_solver.direct_factor(),
-                                  !guess.empty(),
-                                  output_writer.test_mode() ? quiet : loop_log);
-            contact_system = std::move(choice.system);
-            solver_name    = std::move(choice.name);
-            solver_figures = std::move(choice.figures);
-            // On several ranks the iterative path keeps its ranks' rows
-            // of C and the rows of the contact and constrained dofs: the
-            // whole matrix is released until the next assembly (8 bytes
-            // per entry on every rank; the pattern stays).
-            if (auto *iterative =
-                  dynamic_cast<IterativeContactSystem *>(contact_system.get());
-                iterative != nullptr && parallel::n_ranks() > 1)
-              {
-                const double MB = system_matrix.memory_consumption() / 1048576.;
-                system_matrix.clear();
-                iterative->matrix_released(MB);
-              }
-          }
+        // A new system: made here from C, unless the path took its rows
+        // at the assembly (assemble_system()).
+        if (new_matrix && !contact_system)
+          make_solver();
         if (!contact_pairs.frictional())
           {
             contact_system->set_rhs(system_rhs);
@@ -476,7 +448,8 @@ namespace knee_contact
               }
           }
         contact_system->solution(displacement);
-        solver_figures["contact_solve"] = clock.wall_time();
+        solver_figures["contact_solve"] =
+          clock.wall_time() + (new_matrix ? solver_figures["choice"] : 0.);
         for (const auto &[name, value] : contact_system->statistics())
           solver_figures[name] = value;
         if (new_matrix && active_set_solver.measure_reference() &&
@@ -576,6 +549,68 @@ namespace knee_contact
 
 
   template <int dim>
+  void
+  ContactProblem<dim>::assemble_system(const bool warm_start)
+  {
+    // The previous system (its factor) goes before the new one is made.
+    contact_system.reset();
+    system_matrix.clear();
+    Timer clock;
+    solver_plan = plan_contact_system(active_set_solver.linear_solver(),
+                                      sparsity_pattern,
+                                      system_matrix,
+                                      constraints,
+                                      rows_for_solver(),
+                                      active_set_solver.direct_factor(),
+                                      warm_start);
+    solver_plan.figures["choice"] = clock.wall_time();
+    const ElasticityAssembler<dim> assembler(materials, boundary_conditions);
+    if (!solver_plan.rows_only)
+      {
+        system_matrix.reinit(sparsity_pattern);
+        assembler.assemble(dof_handler, system_matrix, system_rhs);
+        return;
+      }
+    // Each rank assembles the rows its path holds (C whole, 8 bytes per
+    // entry on every rank, is never made) and d whole (a pass over the
+    // cells without their matrices). The choice is timed apart: the
+    // assembly phase holds it, and contact_solve counts it.
+    assembler.assemble_rhs(dof_handler, system_rhs);
+    make_solver();
+  }
+
+
+
+  template <int dim>
+  void
+  ContactProblem<dim>::make_solver()
+  {
+    std::ostream &log =
+      output_writer.test_mode() || contact_pairs.empty() ? quiet : std::cout;
+    const IterativeContactSystem::RowAssembly rows = [this](const auto &wanted,
+                                                            const auto &add) {
+      ElasticityAssembler<dim>(materials, boundary_conditions)
+        .assemble_cells(dof_handler, wanted, add);
+    };
+    const bool   rows_only = solver_plan.rows_only;
+    SolverChoice choice =
+      make_contact_system(std::move(solver_plan),
+                          sparsity_pattern,
+                          system_matrix,
+                          rows_only ? &rows : nullptr,
+                          constraints,
+                          rows_for_solver(),
+                          *rigid_modes,
+                          active_set_solver.krylov_settings(),
+                          log);
+    contact_system = std::move(choice.system);
+    solver_name    = std::move(choice.name);
+    solver_figures = std::move(choice.figures);
+  }
+
+
+
+  template <int dim>
   std::vector<bool>
   ContactProblem<dim>::move_to_case(const double t_from, const double t_to)
   {
@@ -596,8 +631,7 @@ namespace knee_contact
     setup_system();
     // The same cells and element: the same dof numbering.
     AssertThrow(dof_handler.n_dofs() == previous_u.size(), ExcInternalError());
-    ElasticityAssembler<dim>(materials, boundary_conditions)
-      .assemble(dof_handler, system_matrix, system_rhs);
+    assemble_system(true);
 
     const unsigned int  n = contact_pairs.size();
     std::vector<bool>   guess(n, false);
@@ -661,14 +695,13 @@ namespace knee_contact
   ProblemAccess<dim>
   ContactProblem<dim>::access() const
   {
-    // C's product: the matrix's, or the iterative path's once the matrix
-    // was released (solve_contact()).
+    // C's product: the matrix's, or the path's where it holds C's rows
+    // and C whole is not made (the iterative path on several ranks).
     const auto product = [this](Vector<double> &y, const Vector<double> &x) {
-      if (!system_matrix.empty())
-        system_matrix.vmult(y, x);
+      if (contact_system && contact_system->holds_stiffness())
+        contact_system->stiffness_product(y, x);
       else
-        dynamic_cast<const IterativeContactSystem &>(*contact_system)
-          .stiffness_product(y, x);
+        system_matrix.vmult(y, x);
     };
     return {dof_handler,
             body_of_cell,

@@ -1,6 +1,7 @@
 #include <knee_contact/base/input.h>
 #include <knee_contact/base/interruption.h>
 #include <knee_contact/base/memory.h>
+#include <knee_contact/base/parallel.h>
 #include <knee_contact/mesh/gmsh_input.h>
 #include <knee_contact/mesh/mesh.h>
 #include <knee_contact/mesh/mesh_readers.h>
@@ -501,10 +502,13 @@ namespace knee_contact
     // cell and 81 entries a row; tetrahedra (as hexahedra of twice their
     // vertices) 1.5 dofs per such cell and 45 entries. (The former 12 kB
     // per such cell, 8 kB per tetrahedral dof, refused the knee at 4.2e6
-    // dofs: 33 GB.)
-    const double dofs    = (tetrahedra ? 1.5 : 3.) * n_cells;
-    const double entries = tetrahedra ? 45 : 81;
-    return std::min(direct, 5e7 + dofs * (2.5e3 + 40 * entries));
+    // dofs: 33 GB.) On N ranks (each holds the mesh whole) each rank holds
+    // C's pattern whole (4 bytes an entry) and its share of the rest: C is
+    // assembled only as the path's rows there.
+    const double dofs      = (tetrahedra ? 1.5 : 3.) * n_cells;
+    const double entries   = tetrahedra ? 45 : 81;
+    const double per_entry = 4. + 36. / parallel::n_ranks();
+    return std::min(direct, 5e7 + dofs * (2.5e3 + per_entry * entries));
   }
 
 

@@ -6,6 +6,8 @@
 
 #include <deal.II/fe/fe_values.h>
 
+#include <algorithm>
+
 namespace knee_contact
 {
   namespace
@@ -55,8 +57,24 @@ namespace knee_contact
       FullMatrix<double>                   cell_matrix;
       Vector<double>                       cell_rhs;
       std::vector<types::global_dof_index> dof_indices;
+      /** The cell is not wanted (assemble_cells()). */
+      bool skipped = false;
     };
   } // namespace
+
+
+
+  // Where the cells' contributions go: C and d whole, d alone, or the
+  // cell matrices of the wanted cells.
+  template <int dim>
+  struct ElasticityAssembler<dim>::Sinks
+  {
+    SparseMatrix<double>                                     *matrix = nullptr;
+    Vector<double>                                           *rhs    = nullptr;
+    const std::function<bool(const types::global_dof_index)> *wanted = nullptr;
+    const std::function<void(const std::vector<types::global_dof_index> &,
+                             const FullMatrix<double> &)>    *cells  = nullptr;
+  };
 
 
 
@@ -77,7 +95,11 @@ namespace knee_contact
                                      Vector<double>        &rhs) const
   {
     matrix = 0;
-    assemble(dof_handler, &matrix, rhs);
+    rhs.reinit(dof_handler.n_dofs());
+    Sinks sinks;
+    sinks.matrix = &matrix;
+    sinks.rhs    = &rhs;
+    assemble(dof_handler, sinks);
   }
 
 
@@ -87,7 +109,26 @@ namespace knee_contact
   ElasticityAssembler<dim>::assemble_rhs(const DoFHandler<dim> &dof_handler,
                                          Vector<double>        &rhs) const
   {
-    assemble(dof_handler, nullptr, rhs);
+    rhs.reinit(dof_handler.n_dofs());
+    Sinks sinks;
+    sinks.rhs = &rhs;
+    assemble(dof_handler, sinks);
+  }
+
+
+
+  template <int dim>
+  void
+  ElasticityAssembler<dim>::assemble_cells(
+    const DoFHandler<dim>                                    &dof_handler,
+    const std::function<bool(const types::global_dof_index)> &wanted,
+    const std::function<void(const std::vector<types::global_dof_index> &,
+                             const FullMatrix<double> &)>    &add) const
+  {
+    Sinks sinks;
+    sinks.wanted = &wanted;
+    sinks.cells  = &add;
+    assemble(dof_handler, sinks);
   }
 
 
@@ -95,15 +136,14 @@ namespace knee_contact
   template <int dim>
   void
   ElasticityAssembler<dim>::assemble(const DoFHandler<dim> &dof_handler,
-                                     SparseMatrix<double>  *matrix,
-                                     Vector<double>        &rhs) const
+                                     const Sinks           &sinks) const
   {
-    rhs.reinit(dof_handler.n_dofs());
-    const bool with_matrix = matrix != nullptr;
+    const bool with_matrix = sinks.matrix != nullptr || sinks.cells != nullptr;
+    const bool with_rhs    = sinks.rhs != nullptr;
 
     // a(u, v) = int e(v) : c : e(u) dx and L(v) = int F.v dx + int P.v ds,
     // the seed's eq. (5), cell by cell.
-    const auto worker = [this, with_matrix](
+    const auto worker = [this, with_matrix, with_rhs, &sinks](
                           const typename DoFHandler<dim>::active_cell_iterator
                                            &cell,
                           ScratchData<dim> &scratch,
@@ -111,20 +151,29 @@ namespace knee_contact
       const FiniteElement<dim> &fe       = cell->get_fe();
       const unsigned int        n        = fe.n_dofs_per_cell();
       const Material<dim>      &material = materials[cell->material_id()];
-      copy.cell_matrix.reinit(n, n);
-      copy.cell_rhs.reinit(n);
       copy.dof_indices.resize(n);
       cell->get_dof_indices(copy.dof_indices);
+      copy.skipped = sinks.wanted != nullptr &&
+                     std::none_of(copy.dof_indices.begin(),
+                                  copy.dof_indices.end(),
+                                  [&](const types::global_dof_index i) {
+                                    return (*sinks.wanted)(i);
+                                  });
+      if (copy.skipped)
+        return;
+      copy.cell_matrix.reinit(n, n);
+      copy.cell_rhs.reinit(n);
 
       // A further load case with zero body force needs only the faces.
-      const bool volume = with_matrix || !material.body_force_is_zero;
+      const bool volume =
+        with_matrix || (with_rhs && !material.body_force_is_zero);
       if (volume)
         scratch.fe_values.reinit(cell);
       const FEValues<dim> &fev = scratch.fe_values;
       Vector<double>       force(dim);
       for (unsigned int q = 0; volume && q < fev.n_quadrature_points; ++q)
         {
-          if (!material.body_force_is_zero)
+          if (with_rhs && !material.body_force_is_zero)
             material.body_force->vector_value(fev.quadrature_point(q), force);
           for (unsigned int i = 0; i < n; ++i)
             {
@@ -162,7 +211,7 @@ namespace knee_contact
         }
 
       for (const unsigned int f : cell->face_indices())
-        if (cell->face(f)->at_boundary())
+        if (with_rhs && cell->face(f)->at_boundary())
           for (const auto &condition : boundary_conditions.conditions())
             if ((condition.type == BoundaryType::traction ||
                  condition.type == BoundaryType::pressure) &&
@@ -190,10 +239,15 @@ namespace knee_contact
               }
     };
 
-    const auto copier = [matrix, &rhs](const CopyData &copy) {
-      if (matrix != nullptr)
-        matrix->add(copy.dof_indices, copy.cell_matrix);
-      rhs.add(copy.dof_indices, copy.cell_rhs);
+    const auto copier = [&sinks](const CopyData &copy) {
+      if (copy.skipped)
+        return;
+      if (sinks.matrix != nullptr)
+        sinks.matrix->add(copy.dof_indices, copy.cell_matrix);
+      if (sinks.rhs != nullptr)
+        sinks.rhs->add(copy.dof_indices, copy.cell_rhs);
+      if (sinks.cells != nullptr)
+        (*sinks.cells)(copy.dof_indices, copy.cell_matrix);
     };
 
     WorkStream::run(dof_handler.begin_active(),

@@ -284,30 +284,33 @@ namespace knee_contact
   class IterativeContactSystem::Implementation
   {
   public:
-    Implementation(const SparseMatrix<double>        &matrix,
+    Implementation(const SparsityPattern             &pattern,
+                   const SparseMatrix<double>        *matrix,
+                   const RowAssembly                 *assemble_rows,
                    const AffineConstraints<double>   &base,
                    const std::vector<ContactRow>     &pairs,
                    const std::vector<Vector<double>> &modes,
                    const unsigned int                 components,
                    const KrylovSettings              &settings)
       : matrix(matrix)
-      , pattern(matrix.get_sparsity_pattern())
-      , n(matrix.m())
+      , pattern(pattern)
+      , n(pattern.n_rows())
       , base(base)
       , pairs(pairs)
       , components(components)
       , settings(settings)
-      , x(matrix.m())
+      , x(pattern.n_rows())
     {
       // This rank's rows: whole vertices (the aggregation's blocks), a
       // METIS partition of the vertex graph made on rank 0 (a contiguous
       // block of gmsh's cell-by-cell numbering scattered over the bodies:
       // the 3D knee at 2.3e5 dofs took twice the CG iterations of one
       // rank). Every rank holds the rows (the replicated first stage of the
-      // parallel run, doc/parallel.md); C (after the constructor: rows_of_c()),
-      // the condensed matrix, the hierarchy and the Krylov vectors are
-      // distributed.
+      // parallel run, doc/parallel.md); C (its rows assembled here:
+      // rows_of_c()), the condensed matrix, the hierarchy and the Krylov
+      // vectors are distributed.
       const unsigned int ranks = parallel::n_ranks(), rank = parallel::rank();
+      Timer              clock;
       owned.set_size(n);
       if (ranks == 1 || n % components != 0)
         owned.add_range(n * rank / ranks,
@@ -335,20 +338,21 @@ namespace knee_contact
               owned.add_range(b * components, (b + 1) * components);
         }
       owned.compress();
+      partition_time = clock.wall_time();
       // ML reads the near null space as one column-major array.
-      null_space.resize(modes.size() * matrix.m());
+      null_space.resize(modes.size() * n);
       for (unsigned int k = 0; k < modes.size(); ++k)
-        std::copy(modes[k].begin(),
-                  modes[k].end(),
-                  null_space.begin() + k * matrix.m());
+        std::copy(modes[k].begin(), modes[k].end(), null_space.begin() + k * n);
       n_modes = modes.size();
+      AssertThrow((ranks == 1) == (matrix != nullptr) &&
+                    (ranks == 1) == (assemble_rows == nullptr),
+                  ExcInternalError());
       if (ranks > 1)
-        keep_rows_of_c();
+        assemble_rows_of_c(*assemble_rows);
     }
 
-    /** C whole: on one rank the path's; on several only until the
-     * constructor has taken its rows (the problem may release it then). */
-    const SparseMatrix<double>      &matrix;
+    /** C whole on one rank; none on several (rows_of_c()). */
+    const SparseMatrix<double>      *matrix;
     const SparsityPattern           &pattern;
     const types::global_dof_index    n;
     const AffineConstraints<double> &base;
@@ -412,6 +416,8 @@ namespace knee_contact
     double       resident_at_start = 0, measured_MB = 0;
     unsigned int reference_iterations = 0;
     double       condensation = 0, time_per_product = 0;
+    /** Several ranks: the partition's and the rows' assembly's times. */
+    double       partition_time = 0, rows_assembly = 0;
     unsigned int last_iterations = 0;
     /** The loop's totals for statistics() (the reference solve keeps them
      * as they were). */
@@ -428,26 +434,18 @@ namespace knee_contact
     void
     build_amg(const bool anew = false);
 
-    /** The @p rows of @p from (the stiffness matrix's pattern, this
-     * rank's rows) into @p to, which holds this rank's rows (made on the
-     * first call). */
-    void
-    copy_rows(const SparseMatrix<double>                 &from,
-              TrilinosWrappers::SparseMatrix             &to,
-              const std::vector<types::global_dof_index> &rows);
-
     /** Several ranks: this rank's rows of C into distributed_matrix and
-     * the rows of every dof a line can hold into line_rows, so that C
-     * itself is no longer read. */
+     * the rows of every dof a line can hold into line_rows, assembled by
+     * @p assemble (C whole is never made). */
     void
-    keep_rows_of_c();
+    assemble_rows_of_c(const RowAssembly &assemble);
 
     /** The deal.II matrix holding C's rows of the lines (and their
      * diagonals): C on one rank, line_rows on several. */
     const SparseMatrix<double> &
     rows_of_c() const
     {
-      return parallel::n_ranks() == 1 ? matrix : line_rows;
+      return parallel::n_ranks() == 1 ? *matrix : line_rows;
     }
 
     /** Calls @p f(column, value) for each entry of C's row @p row (an
@@ -727,10 +725,16 @@ namespace knee_contact
     if (trilinos_pattern.n_rows() != pattern.n_rows())
       {
         trilinos_pattern.reinit(owned, owned, parallel::communicator());
+        // A row at a time (an entry at a time took 1 s at 2.3e5 dofs).
+        std::vector<types::global_dof_index> columns;
         for (const auto row : owned)
-          for (auto entry = pattern.begin(row); entry != pattern.end(row);
-               ++entry)
-            trilinos_pattern.add(row, entry->column());
+          {
+            columns.clear();
+            for (auto entry = pattern.begin(row); entry != pattern.end(row);
+                 ++entry)
+              columns.push_back(entry->column());
+            trilinos_pattern.add_entries(row, columns.begin(), columns.end());
+          }
         trilinos_pattern.compress();
       }
     return trilinos_pattern;
@@ -739,11 +743,9 @@ namespace knee_contact
 
 
   void
-  IterativeContactSystem::Implementation::keep_rows_of_c()
+  IterativeContactSystem::Implementation::assemble_rows_of_c(
+    const RowAssembly &assemble)
   {
-    copy_rows(matrix,
-              distributed_matrix,
-              std::vector<types::global_dof_index>(owned.begin(), owned.end()));
     // The dofs a line can hold: the base's lines and every dof of a
     // contact row (a row eliminates one of its own dofs; so does a tied
     // spring, whose dofs are its rows'). O(surface) rows.
@@ -768,10 +770,36 @@ namespace knee_contact
           line_rows_pattern.add(i, entry->column());
     line_rows_pattern.compress();
     line_rows.reinit(line_rows_pattern);
-    for (types::global_dof_index i = 0; i < n; ++i)
-      if (of_line[i])
-        for (auto entry = matrix.begin(i); entry != matrix.end(i); ++entry)
-          line_rows.set(i, entry->column(), entry->value());
+    distributed_matrix.reinit(owned_pattern());
+
+    // Each rank sums the cells around its rows into them (the cells at a
+    // partition's border on both sides): no rows are sent between ranks.
+    Timer             clock;
+    std::vector<bool> is_owned(n, false);
+    for (const auto i : owned)
+      is_owned[i] = true;
+    std::vector<double> values;
+    assemble(
+      [&](const types::global_dof_index i) {
+        return is_owned[i] || of_line[i];
+      },
+      [&](const std::vector<types::global_dof_index> &dofs,
+          const FullMatrix<double>                   &cell_matrix) {
+        values.resize(dofs.size());
+        for (unsigned int a = 0; a < dofs.size(); ++a)
+          if (is_owned[dofs[a]] || of_line[dofs[a]])
+            {
+              for (unsigned int b = 0; b < dofs.size(); ++b)
+                values[b] = cell_matrix(a, b);
+              if (is_owned[dofs[a]])
+                distributed_matrix.add(
+                  dofs[a], dofs.size(), dofs.data(), values.data(), false);
+              if (of_line[dofs[a]])
+                line_rows.add(dofs[a], dofs.size(), dofs.data(), values.data());
+            }
+      });
+    distributed_matrix.compress(VectorOperation::add);
+    rows_assembly = clock.wall_time();
   }
 
 
@@ -811,7 +839,7 @@ namespace knee_contact
   {
     if (parallel::n_ranks() == 1)
       {
-        matrix.vmult(y, x);
+        matrix->vmult(y, x);
         return;
       }
     // This rank's rows, then every rank takes the whole product.
@@ -825,34 +853,6 @@ namespace knee_contact
     }
     distributed_matrix.vmult(to, from);
     y = Vector<double>(to);
-  }
-
-
-
-  void
-  IterativeContactSystem::Implementation::copy_rows(
-    const SparseMatrix<double>                 &from,
-    TrilinosWrappers::SparseMatrix             &to,
-    const std::vector<types::global_dof_index> &rows)
-  {
-    if (to.m() != from.m())
-      to.reinit(owned_pattern());
-    std::vector<types::global_dof_index> columns;
-    std::vector<double>                  values;
-    for (const auto row : rows)
-      {
-        columns.clear();
-        values.clear();
-        for (auto entry = from.begin(row); entry != from.end(row); ++entry)
-          {
-            columns.push_back(entry->column());
-            values.push_back(entry->value());
-          }
-        // Row by row: deal.II 9.4's reinit from a deal.II matrix corrupted
-        // the heap with rows that are not one contiguous range (measured).
-        to.set(row, columns.size(), columns.data(), values.data());
-      }
-    to.compress(VectorOperation::insert);
   }
 
 
@@ -893,7 +893,7 @@ namespace knee_contact
     };
     if (parallel::n_ranks() == 1)
       {
-        iterative::CondensedOperator operation(matrix,
+        iterative::CondensedOperator operation(*matrix,
                                                constraints,
                                                operator_springs,
                                                *coupling);
@@ -963,10 +963,41 @@ namespace knee_contact
     const KrylovSettings              &settings)
   {
     parallel::ensure_initialised();
-    // (Before the implementation: on several ranks it copies its rows of C.)
     const double resident = iterative::resident_MB();
-    implementation        = std::make_unique<Implementation>(
-      matrix, base, pairs, modes, components, settings);
+    implementation =
+      std::make_unique<Implementation>(matrix.get_sparsity_pattern(),
+                                       &matrix,
+                                       nullptr,
+                                       base,
+                                       pairs,
+                                       modes,
+                                       components,
+                                       settings);
+    implementation->resident_at_start = resident;
+  }
+
+
+
+  IterativeContactSystem::IterativeContactSystem(
+    const SparsityPattern             &pattern,
+    const RowAssembly                 &assemble_rows,
+    const AffineConstraints<double>   &base,
+    const std::vector<ContactRow>     &pairs,
+    const std::vector<Vector<double>> &modes,
+    const unsigned int                 components,
+    const KrylovSettings              &settings)
+  {
+    parallel::ensure_initialised();
+    // (Before the implementation: it assembles its rows of C.)
+    const double resident = iterative::resident_MB();
+    implementation        = std::make_unique<Implementation>(pattern,
+                                                      nullptr,
+                                                      &assemble_rows,
+                                                      base,
+                                                      pairs,
+                                                      modes,
+                                                      components,
+                                                      settings);
     implementation->resident_at_start = resident;
   }
 
@@ -1301,10 +1332,10 @@ namespace knee_contact
 
 
 
-  void
-  IterativeContactSystem::matrix_released(const double MB)
+  bool
+  IterativeContactSystem::holds_stiffness() const
   {
-    implementation->resident_at_start -= MB;
+    return implementation->matrix == nullptr;
   }
 
 
@@ -1351,6 +1382,8 @@ namespace knee_contact
             {"krylov_time", d.totals.krylov},
             {"condensation", d.condensation},
             {"iterative_memory_MB", d.measured_MB},
+            {"partition", d.partition_time},
+            {"rows_assembly", d.rows_assembly},
             {"reference_krylov_iterations", d.reference_iterations}};
   }
 

@@ -92,48 +92,38 @@ namespace knee_contact
 
 
 
-  // make_contact_system()'s choice, with its name and figures written as it
-  // goes (its branches return from several places).
-  static std::unique_ptr<ContactSystem>
+  // plan_contact_system()'s choice, with its reason and figures written as
+  // it goes (its branches return from several places).
+  static void
   choose(const SolverPath                 requested,
+         const SparsityPattern           &sparsity,
          const SparseMatrix<double>      &matrix,
          const AffineConstraints<double> &base,
          const std::vector<ContactRow>   &pairs,
-         const RigidModeCheck            &rigid_modes,
-         const KrylovSettings            &krylov,
          const DirectFactor               requested_factor,
          const bool                       warm_start,
-         std::ostream                    &log,
-         std::string                     &name,
-         std::map<std::string, double>   &figures)
+         SolverPlan                      &plan)
   {
+    auto &figures    = plan.figures;
     figures["ranks"] = parallel::n_ranks();
     // MUMPS's factor is divided over the ranks (its memory and its work);
     // CHOLMOD's is whole on each.
     const bool mumps =
       resolve_direct_factor(requested_factor) == DirectFactor::mumps;
+    plan.mumps                = mumps;
     const double factor_ranks = mumps ? parallel::n_ranks() : 1.;
     if (requested == SolverPath::step41)
       {
         // The first version's path, kept for comparison: UMFPACK's memory
         // is not known before its factorisation, so it is not estimated.
-        name = "step-41";
-        return std::make_unique<FullContactSystem>(matrix, base, pairs);
+        plan.path = SolverPath::step41;
+        return;
       }
 
     const auto iterative = [&](const std::string &reason) {
-      name = "iterative";
-      log << "   solver: iterative (" << reason << ")";
-      if (parallel::n_ranks() > 1)
-        log << ", distributed over " << parallel::n_ranks() << " ranks";
-      log << std::endl;
-      return std::make_unique<IterativeContactSystem>(
-        matrix,
-        base,
-        pairs,
-        rigid_modes.rigid_motions(),
-        rigid_modes.components(),
-        krylov);
+      plan.path      = SolverPath::iterative;
+      plan.reason    = reason;
+      plan.rows_only = parallel::n_ranks() > 1;
     };
     // The iterative path alone (the scene asks for it, or no factor can be
     // made): its own memory estimate must fit.
@@ -141,8 +131,7 @@ namespace knee_contact
       std::string  limit;
       const double available = available_on_every_rank(limit);
       const double bytes =
-        IterativeContactSystem::estimated_bytes(matrix.get_sparsity_pattern(),
-                                                frictional(pairs));
+        IterativeContactSystem::estimated_bytes(sparsity, frictional(pairs));
       figures["estimated_iterative_MB"] = bytes / 1048576.;
       figures["available_MB"]           = available / 1048576.;
       AssertThrow(bytes <= 0.8 * available,
@@ -191,11 +180,12 @@ namespace knee_contact
     // ordering with the contact unknowns moved last.
     // A factor past CHOLMOD's 32-bit indices would not fit in memory
     // either (2^31 entries take 20 GB): the iterative path, if it fits.
-    std::unique_ptr<SparseContactSystem> sparse;
-    Timer                                choice_clock;
+    std::unique_ptr<SparseContactSystem> &sparse = plan.sparse;
+    Timer                                 choice_clock;
     try
       {
-        sparse = std::make_unique<SparseContactSystem>(matrix, base, pairs);
+        sparse =
+          std::make_unique<SparseContactSystem>(matrix, sparsity, base, pairs);
       }
     catch (const sparse_cholesky::FactorTooLarge &too_large)
       {
@@ -210,9 +200,8 @@ namespace knee_contact
       figures["choice_ordering"] = sparse_figures["ordering"];
       figures["choice_analysis"] = sparse_figures["analysis"];
     };
-    const double lnz      = sparse->nnz_factor();
-    const double fl       = sparse->flops();
-    const auto  &sparsity = matrix.get_sparsity_pattern();
+    const double lnz = sparse->nnz_factor();
+    const double fl  = sparse->flops();
     const double nnz_lower =
       (sparsity.n_nonzero_elements() + sparsity.n_rows()) / 2.;
 
@@ -405,19 +394,92 @@ namespace knee_contact
                            "or a machine with more memory"));
 
     if (path == SolverPath::condensed)
+      keep_choice_figures();
+    plan.path         = path;
+    plan.reason       = reason;
+    plan.sparse_bytes = sparse_bytes;
+    plan.available    = available;
+    plan.limit        = limit;
+  }
+
+
+
+  SolverPlan
+  plan_contact_system(const SolverPath                 requested,
+                      const SparsityPattern           &sparsity,
+                      const SparseMatrix<double>      &matrix,
+                      const AffineConstraints<double> &base,
+                      const std::vector<ContactRow>   &pairs,
+                      const DirectFactor               factor,
+                      const bool                       warm_start)
+  {
+    SolverPlan plan;
+    choose(requested, sparsity, matrix, base, pairs, factor, warm_start, plan);
+    return plan;
+  }
+
+
+
+  SolverChoice
+  make_contact_system(SolverPlan                               &&plan,
+                      const SparsityPattern                     &sparsity,
+                      const SparseMatrix<double>                &matrix,
+                      const IterativeContactSystem::RowAssembly *rows,
+                      const AffineConstraints<double>           &base,
+                      const std::vector<ContactRow>             &pairs,
+                      const RigidModeCheck                      &rigid_modes,
+                      const KrylovSettings                      &krylov,
+                      std::ostream                              &log)
+  {
+    AssertThrow(plan.rows_only == (rows != nullptr), ExcInternalError());
+    SolverChoice choice;
+    choice.figures     = std::move(plan.figures);
+    choice.name        = solver_path_name(plan.path);
+    std::string reason = std::move(plan.reason);
+    auto        sparse = std::move(plan.sparse);
+    if (plan.path == SolverPath::step41)
+      {
+        choice.system =
+          std::make_unique<FullContactSystem>(matrix, base, pairs);
+        return choice;
+      }
+    if (plan.path == SolverPath::iterative)
+      {
+        log << "   solver: iterative (" << reason << ")";
+        if (parallel::n_ranks() > 1)
+          log << ", distributed over " << parallel::n_ranks() << " ranks";
+        log << std::endl;
+        if (rows != nullptr)
+          choice.system = std::make_unique<IterativeContactSystem>(
+            sparsity,
+            *rows,
+            base,
+            pairs,
+            rigid_modes.rigid_motions(),
+            rigid_modes.components(),
+            krylov);
+        else
+          choice.system = std::make_unique<IterativeContactSystem>(
+            matrix,
+            base,
+            pairs,
+            rigid_modes.rigid_motions(),
+            rigid_modes.components(),
+            krylov);
+        return choice;
+      }
+    if (plan.path == SolverPath::condensed)
       try
         {
-          keep_choice_figures();
           const std::vector<int> order = sparse->ordering();
           sparse.reset();
-          auto system = std::make_unique<CondensedContactSystem>(matrix,
-                                                                 base,
-                                                                 pairs,
-                                                                 order);
-          name        = "condensed";
+          choice.system = std::make_unique<CondensedContactSystem>(matrix,
+                                                                   base,
+                                                                   pairs,
+                                                                   order);
           log << "   solver: condensed (" << reason << ")" << on_every_rank()
               << std::endl;
-          return system;
+          return choice;
         }
       catch (const ContactSystem::ExcNotPositiveDefinite &)
         {
@@ -426,18 +488,17 @@ namespace knee_contact
           // path constrains before factorising.
           reason = "the interior of a body is not held without its contact "
                    "rows, which the condensed path needs";
-          if (!fits(sparse_bytes))
-            AssertThrow(false,
-                        ExcMessage("out of memory: the contact solve (sparse "
-                                   "path) needs about " +
-                                   megabytes(sparse_bytes) + " more, but " +
-                                   megabytes(available) + " are available (" +
-                                   limit + ")"));
+          AssertThrow(plan.sparse_bytes <= 0.8 * plan.available,
+                      ExcMessage("out of memory: the contact solve (sparse "
+                                 "path) needs about " +
+                                 megabytes(plan.sparse_bytes) + " more, but " +
+                                 megabytes(plan.available) +
+                                 " are available (" + plan.limit + ")"));
           sparse = std::make_unique<SparseContactSystem>(matrix, base, pairs);
         }
-    name = "sparse";
+    choice.name = "sparse";
     log << "   solver: sparse (" << reason << ")";
-    if (mumps)
+    if (plan.mumps)
       {
         sparse->use_mumps();
         log << ", MUMPS's factor distributed over " << parallel::n_ranks()
@@ -445,34 +506,7 @@ namespace knee_contact
       }
     else
       log << on_every_rank() << std::endl;
-    return sparse;
-  }
-
-
-
-  SolverChoice
-  make_contact_system(const SolverPath                 requested,
-                      const SparseMatrix<double>      &matrix,
-                      const AffineConstraints<double> &base,
-                      const std::vector<ContactRow>   &pairs,
-                      const RigidModeCheck            &rigid_modes,
-                      const KrylovSettings            &krylov,
-                      const DirectFactor               factor,
-                      const bool                       warm_start,
-                      std::ostream                    &log)
-  {
-    SolverChoice choice;
-    choice.system = choose(requested,
-                           matrix,
-                           base,
-                           pairs,
-                           rigid_modes,
-                           krylov,
-                           factor,
-                           warm_start,
-                           log,
-                           choice.name,
-                           choice.figures);
+    choice.system = std::move(sparse);
     return choice;
   }
 } // namespace knee_contact

@@ -400,13 +400,22 @@ namespace knee_contact
     const SparseMatrix<double>      &matrix,
     const AffineConstraints<double> &base,
     const std::vector<ContactRow>   &pairs)
+    : SparseContactSystem(matrix, matrix.get_sparsity_pattern(), base, pairs)
+  {}
+
+
+
+  SparseContactSystem::SparseContactSystem(
+    const SparseMatrix<double>      &matrix,
+    const SparsityPattern           &sparsity,
+    const AffineConstraints<double> &base,
+    const std::vector<ContactRow>   &pairs)
     : implementation(std::make_unique<Implementation>(matrix, base, pairs))
   {
     Implementation &d = *implementation;
     // The pattern of every active set: each entry of the matrix's pattern.
-    const auto pattern =
-      sparse_cholesky::pattern_of(matrix.get_sparsity_pattern());
-    Timer clock;
+    const auto pattern = sparse_cholesky::pattern_of(sparsity);
+    Timer      clock;
     d.order    = sparse_cholesky::fill_reducing_ordering(pattern, {});
     d.ordering = clock.wall_time();
     clock.restart();

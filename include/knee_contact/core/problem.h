@@ -5,6 +5,7 @@
 #include <knee_contact/mesh/mesh.h>
 #include <knee_contact/physics/boundary_conditions.h>
 #include <knee_contact/physics/materials.h>
+#include <knee_contact/physics/rigid_modes.h>
 #include <knee_contact/physics/rigid_motions.h>
 #include <knee_contact/postprocess/load_cases.h>
 #include <knee_contact/postprocess/output.h>
@@ -197,6 +198,20 @@ namespace knee_contact
 
     void
     setup_system();
+
+    /**
+     * The solver path, chosen from C's pattern (solver_plan), then C and d:
+     * C whole into system_matrix, or where the path assembles the rows it
+     * holds (the iterative path on several ranks) d alone and the contact
+     * system, which takes its rows. @p warm_start: the loop will start from
+     * a guess (the choice expects fewer iterations).
+     */
+    void
+    assemble_system(const bool warm_start);
+
+    /** contact_system, solver_name and solver_figures from solver_plan. */
+    void
+    make_solver();
 
     /**
      * Solve on Refinement::n_cycles meshes refined by @p strategy, starting
@@ -430,11 +445,15 @@ namespace knee_contact
     {
       return !contact_pairs.frictional() ? contact_pairs.rows : friction_rows;
     }
-    SparsityPattern      sparsity_pattern;
-    SparseMatrix<double> system_matrix;
-    Vector<double>       system_rhs;
-    Vector<double>       displacement;
-    ContactSolution      contact_solution;
+    /** The bodies' rigid motions on the dofs (setup_system()). */
+    std::unique_ptr<RigidModes<dim>> rigid_modes;
+    SparsityPattern                  sparsity_pattern;
+    SparseMatrix<double>             system_matrix;
+    Vector<double>                   system_rhs;
+    Vector<double>                   displacement;
+    ContactSolution                  contact_solution;
+    /** The path assemble_system() chose for the next contact system. */
+    SolverPlan solver_plan;
     /** The last cycle's factorised system, kept for further load cases. */
     std::unique_ptr<ContactSystem> contact_system;
     /**

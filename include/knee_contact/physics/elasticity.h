@@ -4,10 +4,14 @@
 #include <knee_contact/physics/boundary_conditions.h>
 #include <knee_contact/physics/materials.h>
 
+#include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/vector.h>
 
 #include <deal.II/dofs/dof_handler.h>
+
+#include <functional>
+#include <vector>
 
 namespace knee_contact
 {
@@ -44,11 +48,25 @@ namespace knee_contact
     void
     assemble_rhs(const DoFHandler<dim> &dof_handler, Vector<double> &rhs) const;
 
-  private:
+    /**
+     * The cell matrices of the cells with a dof @p wanted says yes to,
+     * each given to @p add(dofs, cell matrix) as it is made (one call at
+     * a time; the cells in parallel by WorkStream): the rows a rank holds
+     * of C, summed where they are kept (IterativeContactSystem on several
+     * ranks), without C whole.
+     */
     void
-    assemble(const DoFHandler<dim> &dof_handler,
-             SparseMatrix<double>  *matrix,
-             Vector<double>        &rhs) const;
+    assemble_cells(
+      const DoFHandler<dim>                                    &dof_handler,
+      const std::function<bool(const types::global_dof_index)> &wanted,
+      const std::function<void(const std::vector<types::global_dof_index> &,
+                               const FullMatrix<double> &)>    &add) const;
+
+  private:
+    struct Sinks;
+
+    void
+    assemble(const DoFHandler<dim> &dof_handler, const Sinks &sinks) const;
 
     const Materials<dim>          &materials;
     const BoundaryConditions<dim> &boundary_conditions;

@@ -6,9 +6,11 @@
 #include <knee_contact/solver/sparse_factor.h>
 
 #include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/vector.h>
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <ostream>
@@ -197,6 +199,25 @@ namespace knee_contact
     statistics() const
     {
       return {};
+    }
+
+    /**
+     * Whether this path holds C itself (stiffness_product()), where the
+     * whole stiffness matrix is not made: the iterative path on several
+     * ranks, which assembles the rows it holds.
+     */
+    virtual bool
+    holds_stiffness() const
+    {
+      return false;
+    }
+
+    /** y = C x, whole on every rank, where holds_stiffness(). */
+    virtual void
+    stiffness_product(Vector<double> & /*y*/,
+                      const Vector<double> & /*x*/) const
+    {
+      AssertThrow(false, ExcInternalError());
     }
   };
 
@@ -393,6 +414,15 @@ namespace knee_contact
     SparseContactSystem(const SparseMatrix<double>      &matrix,
                         const AffineConstraints<double> &base,
                         const std::vector<ContactRow>   &pairs);
+
+    /**
+     * The same from C's @p pattern, before C is assembled: @p matrix (on
+     * that pattern once assembled) is read from the first solve on.
+     */
+    SparseContactSystem(const SparseMatrix<double>      &matrix,
+                        const SparsityPattern           &pattern,
+                        const AffineConstraints<double> &base,
+                        const std::vector<ContactRow>   &pairs);
     ~SparseContactSystem() override;
 
     void
@@ -511,11 +541,35 @@ namespace knee_contact
   {
   public:
     /**
-     * @p modes: the rigid motions of the mesh (RigidModeCheck::
-     * rigid_motions()), AMG's near null space; @p components: the dofs per
-     * vertex (the block size of the aggregation).
+     * On one rank, from C whole. @p modes: the rigid motions of the mesh
+     * (RigidModeCheck::rigid_motions()), AMG's near null space;
+     * @p components: the dofs per vertex (the block size of the
+     * aggregation).
      */
     IterativeContactSystem(const SparseMatrix<double>        &matrix,
+                           const AffineConstraints<double>   &base,
+                           const std::vector<ContactRow>     &pairs,
+                           const std::vector<Vector<double>> &modes,
+                           const unsigned int                 components,
+                           const KrylovSettings              &settings);
+
+    /**
+     * Assembles C's rows: @p assemble(wanted, add) gives
+     * add(dofs, cell matrix) for each cell with a dof wanted(dof) says yes
+     * to (ElasticityAssembler::assemble_cells()).
+     */
+    using RowAssembly = std::function<void(
+      const std::function<bool(const types::global_dof_index)> &,
+      const std::function<void(const std::vector<types::global_dof_index> &,
+                               const FullMatrix<double> &)> &)>;
+
+    /**
+     * On several ranks, from C's @p pattern: the path assembles the rows
+     * it holds with @p assemble_rows (this rank's, and those of the dofs
+     * a constraint can hold), so that C whole is never made.
+     */
+    IterativeContactSystem(const SparsityPattern             &pattern,
+                           const RowAssembly                 &assemble_rows,
                            const AffineConstraints<double>   &base,
                            const std::vector<ContactRow>     &pairs,
                            const std::vector<Vector<double>> &modes,
@@ -596,27 +650,19 @@ namespace knee_contact
     double
     reference_solve(const std::vector<bool> &active, Vector<double> &x);
 
-    /**
-     * y = C x, whole on every rank: on several ranks the stiffness matrix
-     * given to the constructor is no longer read once it is made (its
-     * rows are this path's), and its holder may release it.
-     */
+    /** On several ranks (the second constructor). */
+    bool
+    holds_stiffness() const override;
+
     void
-    stiffness_product(Vector<double> &y, const Vector<double> &x) const;
+    stiffness_product(Vector<double>       &y,
+                      const Vector<double> &x) const override;
 
     /**
-     * The holder released @p MB of the matrix after making this path: its
-     * measured memory (iterative_memory_MB, the resident growth by its
-     * first solve) counts them back.
-     */
-    void
-    matrix_released(const double MB);
-
-    /**
-     * Peak memory [bytes] the path adds to the stiffness matrix, from the
-     * pattern: the condensed copy while it is handed over, Trilinos' matrix,
-     * the hierarchy and the Krylov vectors (measured: doc/performance.md);
-     * with @p friction GMRES's basis.
+     * Peak memory [bytes] the path adds to C's pattern (and on one rank to
+     * C), from the pattern: the condensed copy while it is handed over,
+     * Trilinos' matrix, the hierarchy and the Krylov vectors (measured:
+     * doc/performance.md); with @p friction GMRES's basis.
      */
     static double
     estimated_bytes(const SparsityPattern &pattern, const bool friction);
@@ -654,7 +700,32 @@ namespace knee_contact
   std::string
   solver_path_name(const SolverPath path);
 
-  /** What make_contact_system() chose. */
+  /**
+   * The path plan_contact_system() chose from C's pattern, before C is
+   * assembled, for make_contact_system().
+   */
+  struct SolverPlan
+  {
+    SolverPath path = SolverPath::automatic;
+    /** Why (the log line's). */
+    std::string reason;
+    /** The estimates behind the choice (summary.json's "solver"). */
+    std::map<std::string, double> figures;
+    /** The sparse path's ordering and analysis made for the choice (the
+     * sparse and condensed paths take them). */
+    std::unique_ptr<SparseContactSystem> sparse;
+    /** The sparse path's factor is MUMPS's. */
+    bool mumps = false;
+    /** The iterative path on several ranks: it assembles the rows it holds
+     * (make_contact_system()'s @p rows), C whole is not made. */
+    bool rows_only = false;
+    /** The sparse path's estimate and the memory available (a condensed
+     * path that cannot be made falls back to the sparse one). */
+    double      sparse_bytes = 0, available = 0;
+    std::string limit;
+  };
+
+  /** What make_contact_system() made. */
   struct SolverChoice
   {
     std::unique_ptr<ContactSystem> system;
@@ -667,29 +738,46 @@ namespace knee_contact
 
 
   /**
-   * The one factory of the solver seam. For SolverPath::automatic it
-   * estimates, before allocating, the time (flops) and peak memory of the
-   * condensed path (its dense interface arrays, k^3 and P^3 work) and of
-   * the sparse path (factor size and flops from CHOLMOD's symbolic
-   * analysis, times the expected iterations) and takes the cheaper that
-   * fits in the memory available to the process (MemAvailable, the cgroup
-   * limit, ulimit -v); a requested path that does not fit is switched, and
-   * if none fits the run is refused in one line naming the estimate and
-   * the limit. @p factor: the sparse path's factor library (MUMPS's is
-   * divided over the ranks, in the estimates too). @p warm_start: the loop
-   * starts from a guess (a refined mesh, a further load case), so fewer
-   * iterations are expected. @p log gets one line saying which path and why.
+   * The first half of the one factory of the solver seam: the path, from
+   * C's pattern @p sparsity alone (before C is assembled into @p matrix,
+   * which only the sparse path's analysis keeps a reference to). For
+   * SolverPath::automatic it estimates, before allocating, the time
+   * (flops) and peak memory of the condensed path (its dense interface
+   * arrays, k^3 and P^3 work), of the sparse path (factor size and flops
+   * from CHOLMOD's symbolic analysis, times the expected iterations) and
+   * of the iterative path, and takes the cheapest that fits in the memory
+   * available to the process (MemAvailable, the cgroup limit, ulimit -v); a
+   * requested path that does not fit is switched, and if none fits the run
+   * is refused in one line naming the estimate and the limit. @p factor:
+   * the sparse path's factor library (MUMPS's is divided over the ranks, in
+   * the estimates too). @p warm_start: the loop starts from a guess (a
+   * refined mesh, a further load case), so fewer iterations are expected.
    */
-  SolverChoice
-  make_contact_system(const SolverPath                 requested,
+  SolverPlan
+  plan_contact_system(const SolverPath                 requested,
+                      const SparsityPattern           &sparsity,
                       const SparseMatrix<double>      &matrix,
                       const AffineConstraints<double> &base,
                       const std::vector<ContactRow>   &pairs,
-                      const RigidModeCheck            &rigid_modes,
-                      const KrylovSettings            &krylov,
                       const DirectFactor               factor,
-                      const bool                       warm_start,
-                      std::ostream                    &log);
+                      const bool                       warm_start);
+
+  /**
+   * The second half: the contact system of @p plan, from C assembled in
+   * @p matrix, or where plan.rows_only from the rows @p rows assembles
+   * (@p matrix is then not read). @p log gets one line saying which path
+   * and why.
+   */
+  SolverChoice
+  make_contact_system(SolverPlan                               &&plan,
+                      const SparsityPattern                     &sparsity,
+                      const SparseMatrix<double>                &matrix,
+                      const IterativeContactSystem::RowAssembly *rows,
+                      const AffineConstraints<double>           &base,
+                      const std::vector<ContactRow>             &pairs,
+                      const RigidModeCheck                      &rigid_modes,
+                      const KrylovSettings                      &krylov,
+                      std::ostream                              &log);
 
 
 
