@@ -961,20 +961,15 @@ namespace knee_contact
     const std::vector<Vector<double>> &modes,
     const unsigned int                 components,
     const KrylovSettings              &settings)
-  {
-    parallel::ensure_initialised();
-    const double resident = iterative::resident_MB();
-    implementation =
-      std::make_unique<Implementation>(matrix.get_sparsity_pattern(),
-                                       &matrix,
-                                       nullptr,
-                                       base,
-                                       pairs,
-                                       modes,
-                                       components,
-                                       settings);
-    implementation->resident_at_start = resident;
-  }
+    : IterativeContactSystem(matrix.get_sparsity_pattern(),
+                             &matrix,
+                             nullptr,
+                             base,
+                             pairs,
+                             modes,
+                             components,
+                             settings)
+  {}
 
 
 
@@ -986,18 +981,33 @@ namespace knee_contact
     const std::vector<Vector<double>> &modes,
     const unsigned int                 components,
     const KrylovSettings              &settings)
+    : IterativeContactSystem(pattern,
+                             nullptr,
+                             &assemble_rows,
+                             base,
+                             pairs,
+                             modes,
+                             components,
+                             settings)
+  {}
+
+
+
+  IterativeContactSystem::IterativeContactSystem(
+    const SparsityPattern             &pattern,
+    const SparseMatrix<double>        *matrix,
+    const RowAssembly                 *assemble_rows,
+    const AffineConstraints<double>   &base,
+    const std::vector<ContactRow>     &pairs,
+    const std::vector<Vector<double>> &modes,
+    const unsigned int                 components,
+    const KrylovSettings              &settings)
   {
     parallel::ensure_initialised();
-    // (Before the implementation: it assembles its rows of C.)
+    // (Before the implementation: on several ranks it assembles its rows.)
     const double resident = iterative::resident_MB();
-    implementation        = std::make_unique<Implementation>(pattern,
-                                                      nullptr,
-                                                      &assemble_rows,
-                                                      base,
-                                                      pairs,
-                                                      modes,
-                                                      components,
-                                                      settings);
+    implementation        = std::make_unique<Implementation>(
+      pattern, matrix, assemble_rows, base, pairs, modes, components, settings);
     implementation->resident_at_start = resident;
   }
 

@@ -92,20 +92,20 @@ namespace knee_contact
 
 
 
-  // plan_contact_system()'s choice, with its reason and figures written as
-  // it goes (its branches return from several places).
-  static void
-  choose(const SolverPath                 requested,
-         const SparsityPattern           &sparsity,
-         const SparseMatrix<double>      &matrix,
-         const AffineConstraints<double> &base,
-         const std::vector<ContactRow>   &pairs,
-         const DirectFactor               requested_factor,
-         const bool                       warm_start,
-         SolverPlan                      &plan)
+  SolverPlan
+  plan_contact_system(const SolverPath                 requested,
+                      const SparsityPattern           &sparsity,
+                      const SparseMatrix<double>      &matrix,
+                      const AffineConstraints<double> &base,
+                      const std::vector<ContactRow>   &pairs,
+                      const DirectFactor               requested_factor,
+                      const bool                       warm_start)
   {
-    auto &figures    = plan.figures;
-    figures["ranks"] = parallel::n_ranks();
+    // The reason and figures are written as the choice goes (its branches
+    // return from several places).
+    SolverPlan plan;
+    auto      &figures = plan.figures;
+    figures["ranks"]   = parallel::n_ranks();
     // MUMPS's factor is divided over the ranks (its memory and its work);
     // CHOLMOD's is whole on each.
     const bool mumps =
@@ -117,13 +117,14 @@ namespace knee_contact
         // The first version's path, kept for comparison: UMFPACK's memory
         // is not known before its factorisation, so it is not estimated.
         plan.path = SolverPath::step41;
-        return;
+        return plan;
       }
 
     const auto iterative = [&](const std::string &reason) {
       plan.path      = SolverPath::iterative;
       plan.reason    = reason;
       plan.rows_only = parallel::n_ranks() > 1;
+      return std::move(plan);
     };
     // The iterative path alone (the scene asks for it, or no factor can be
     // made): its own memory estimate must fit.
@@ -400,21 +401,6 @@ namespace knee_contact
     plan.sparse_bytes = sparse_bytes;
     plan.available    = available;
     plan.limit        = limit;
-  }
-
-
-
-  SolverPlan
-  plan_contact_system(const SolverPath                 requested,
-                      const SparsityPattern           &sparsity,
-                      const SparseMatrix<double>      &matrix,
-                      const AffineConstraints<double> &base,
-                      const std::vector<ContactRow>   &pairs,
-                      const DirectFactor               factor,
-                      const bool                       warm_start)
-  {
-    SolverPlan plan;
-    choose(requested, sparsity, matrix, base, pairs, factor, warm_start, plan);
     return plan;
   }
 

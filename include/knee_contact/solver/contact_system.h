@@ -678,6 +678,16 @@ namespace knee_contact
     static constexpr unsigned int gmres_basis = 60;
 
   private:
+    /** Both: C whole (@p matrix) or its rows (@p assemble_rows). */
+    IterativeContactSystem(const SparsityPattern             &pattern,
+                           const SparseMatrix<double>        *matrix,
+                           const RowAssembly                 *assemble_rows,
+                           const AffineConstraints<double>   &base,
+                           const std::vector<ContactRow>     &pairs,
+                           const std::vector<Vector<double>> &modes,
+                           const unsigned int                 components,
+                           const KrylovSettings              &settings);
+
     class Implementation;
     std::unique_ptr<Implementation> implementation;
   };
