@@ -164,42 +164,61 @@ namespace knee_contact
       copy.cell_matrix.reinit(n, n);
       copy.cell_rhs.reinit(n);
 
-      // A further load case with zero body force needs only the faces.
-      const bool volume =
-        with_matrix || (with_rhs && !material.body_force_is_zero);
-      if (volume)
+      // A linear simplex's strains are constant on it: its one-point rule
+      // (fe_values_reduced) integrates the stiffness exactly, with a
+      // quarter of the products of the four-point rule a body force
+      // F(x) needs (the assembly of the 3D knee at 2.3e5 dofs: 2.66 s
+      // before on one process). A quadrilateral or hexahedron takes the
+      // full rule, its volumetric part optionally reduced.
+      const bool simplex =
+        cell->reference_cell().is_simplex() && fe.tensor_degree() == 1;
+      const bool body_force = with_rhs && !material.body_force_is_zero;
+      const FEValues<dim> &stiffness =
+        simplex ? scratch.fe_values_reduced : scratch.fe_values;
+      if (with_matrix && (simplex || material.reduced_volumetric))
+        scratch.fe_values_reduced.reinit(cell);
+      if ((with_matrix && !simplex) || body_force)
         scratch.fe_values.reinit(cell);
-      const FEValues<dim> &fev = scratch.fe_values;
-      Vector<double>       force(dim);
-      for (unsigned int q = 0; volume && q < fev.n_quadrature_points; ++q)
+      if (with_matrix)
         {
-          if (with_rhs && !material.body_force_is_zero)
-            material.body_force->vector_value(fev.quadrature_point(q), force);
-          for (unsigned int i = 0; i < n; ++i)
+          const double lambda =
+            material.reduced_volumetric && !simplex ? 0. : material.lambda;
+          for (const unsigned int q : stiffness.quadrature_point_indices())
+            for (unsigned int i = 0; i < n; ++i)
+              {
+                const unsigned int   ci = fe.system_to_component_index(i).first;
+                const Tensor<1, dim> gi = stiffness.shape_grad(i, q);
+                for (unsigned int j = 0; j < n; ++j)
+                  {
+                    const unsigned int cj =
+                      fe.system_to_component_index(j).first;
+                    const Tensor<1, dim> gj = stiffness.shape_grad(j, q);
+                    // c_ijkl for isotropic material, written per component
+                    // pair as in step-8.
+                    copy.cell_matrix(i, j) +=
+                      (gi[ci] * gj[cj] * lambda +
+                       gi[cj] * gj[ci] * material.mu +
+                       (ci == cj ? gi * gj * material.mu : 0.)) *
+                      stiffness.JxW(q);
+                  }
+              }
+        }
+      if (body_force)
+        {
+          const FEValues<dim> &fev = scratch.fe_values;
+          Vector<double>       force(dim);
+          for (const unsigned int q : fev.quadrature_point_indices())
             {
-              const unsigned int   ci = fe.system_to_component_index(i).first;
-              const Tensor<1, dim> gi = fev.shape_grad(i, q);
-              for (unsigned int j = 0; with_matrix && j < n; ++j)
-                {
-                  const unsigned int cj = fe.system_to_component_index(j).first;
-                  const Tensor<1, dim> gj = fev.shape_grad(j, q);
-                  // c_ijkl for isotropic material, written per component
-                  // pair as in step-8.
-                  const double lambda =
-                    material.reduced_volumetric ? 0. : material.lambda;
-                  copy.cell_matrix(i, j) +=
-                    (gi[ci] * gj[cj] * lambda + gi[cj] * gj[ci] * material.mu +
-                     (ci == cj ? gi * gj * material.mu : 0.)) *
-                    fev.JxW(q);
-                }
-              copy.cell_rhs(i) +=
-                fev.shape_value(i, q) * force(ci) * fev.JxW(q);
+              material.body_force->vector_value(fev.quadrature_point(q), force);
+              for (unsigned int i = 0; i < n; ++i)
+                copy.cell_rhs(i) +=
+                  fev.shape_value(i, q) *
+                  force(fe.system_to_component_index(i).first) * fev.JxW(q);
             }
         }
 
-      if (with_matrix && material.reduced_volumetric)
+      if (with_matrix && material.reduced_volumetric && !simplex)
         {
-          scratch.fe_values_reduced.reinit(cell);
           const FEValues<dim> &fer = scratch.fe_values_reduced;
           for (const unsigned int q : fer.quadrature_point_indices())
             for (unsigned int i = 0; i < n; ++i)
