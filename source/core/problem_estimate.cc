@@ -430,14 +430,14 @@ namespace knee_contact
         const types::material_id id       = cell->material_id();
         const Material<dim>     &material = materials[id];
         auto                    &e        = extremes[id];
-        for (unsigned int v = 0; v < GeometryInfo<dim>::vertices_per_cell; ++v)
+        for (unsigned int v = 0; v < n_vertices; ++v)
           {
-            const SymmetricTensor<2, dim> stress = material.stress(
-              recovered(cell->vertex_index(std::min(v, n_vertices - 1)), id));
+            const SymmetricTensor<2, dim> stress =
+              material.stress(recovered(cell->vertex_index(v), id));
+            const double syy =
+              results.stress_yy_at(cell->active_cell_index(), v);
             const std::array<double, 3> fe = {
-              {-results.vertex_stress_yy[cell->active_cell_index()][v],
-               results.vertex_stress_yy[cell->active_cell_index()][v],
-               results.vertex_von_mises[cell->active_cell_index()][v]}};
+              {-syy, syy, results.von_mises_at(cell->active_cell_index(), v)}};
             const std::array<double, 3> star = {
               {-stress[1][1], stress[1][1], material.von_mises(stress)}};
             for (unsigned int k = 0; k < 3; ++k)
@@ -447,8 +447,7 @@ namespace knee_contact
                     e[k].fe              = fe[k];
                     e[k].recovered_there = star[k];
                     e[k].cell            = cell;
-                    e[k].vertex =
-                      cell->vertex_index(std::min(v, n_vertices - 1));
+                    e[k].vertex          = cell->vertex_index(v);
                   }
                 e[k].recovered =
                   e[k].set ? std::max(e[k].recovered, star[k]) : star[k];

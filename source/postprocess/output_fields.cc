@@ -427,7 +427,7 @@ namespace knee_contact
                 data.push_back(solution(cell->vertex_dof_index(v, 0)));
                 data.push_back(solution(cell->vertex_dof_index(v, 1)));
                 data.push_back(
-                  results.vertex_stress_yy[cell->active_cell_index()][v]);
+                  results.stress_yy_at(cell->active_cell_index(), v));
               }
           }
       }
@@ -461,7 +461,7 @@ namespace knee_contact
                     for (unsigned int d = 0; d < dim; ++d)
                       data.push_back(solution(cell->vertex_dof_index(v, d)));
                     data.push_back(
-                      results.vertex_von_mises[cell->active_cell_index()][v]);
+                      results.von_mises_at(cell->active_cell_index(), v));
                   }
               }
       }

@@ -122,8 +122,7 @@ namespace knee_contact
 
     // tau_yy and von Mises at the vertices of every cell, as the pictures
     // show them. (Q1: the trapezoidal rule's points are the vertices in
-    // deal.II's order; P1: the simplex's vertices. A simplex repeats its
-    // last vertex in the remaining entries, as cells.npy does.)
+    // deal.II's order; P1: the simplex's vertices.)
     const ReferenceCell kind = dof_handler.get_fe().reference_cell();
     FEValues<dim>       fe_values(elements::mapping(dof_handler),
                             dof_handler.get_fe(),
@@ -132,8 +131,9 @@ namespace knee_contact
     const unsigned int  n_vertices = kind.n_vertices();
     std::vector<SymmetricTensor<2, dim>> strains(n_vertices);
     const FEValuesExtractors::Vector     displacement(0);
-    results.vertex_stress_yy.resize(results.n_cells);
-    results.vertex_von_mises.resize(results.n_cells);
+    results.n_cell_vertices = n_vertices;
+    results.vertex_stress_yy.resize(std::size_t(results.n_cells) * n_vertices);
+    results.vertex_von_mises.resize(std::size_t(results.n_cells) * n_vertices);
     for (const auto &cell : dof_handler.active_cell_iterators())
       {
         fe_values.reinit(cell);
@@ -145,14 +145,15 @@ namespace knee_contact
           std::make_pair(std::numeric_limits<double>::max(),
                          -std::numeric_limits<double>::max()));
         double &von_mises_max = results.von_mises_max[cell->material_id()];
-        for (unsigned int v = 0; v < GeometryInfo<dim>::vertices_per_cell; ++v)
+        for (unsigned int v = 0; v < n_vertices; ++v)
           {
-            const SymmetricTensor<2, dim> stress =
-              material.stress(strains[std::min(v, n_vertices - 1)]);
-            const double syy = stress[1][1];
-            results.vertex_stress_yy[cell->active_cell_index()][v] = syy;
-            const double von_mises = material.von_mises(stress);
-            results.vertex_von_mises[cell->active_cell_index()][v] = von_mises;
+            const SymmetricTensor<2, dim> stress = material.stress(strains[v]);
+            const double                  syy    = stress[1][1];
+            const std::size_t             entry =
+              results.vertex_entry(cell->active_cell_index(), v);
+            results.vertex_stress_yy[entry] = syy;
+            const double von_mises          = material.von_mises(stress);
+            results.vertex_von_mises[entry] = von_mises;
             von_mises_max = std::max(von_mises_max, von_mises);
             range.first->second.first =
               std::min(range.first->second.first, syy);
