@@ -96,7 +96,7 @@ namespace knee_contact
      * tau_yy [Pa] at the vertices of each active cell, n_cell_vertices a
      * cell (by active_cell_index(), deal.II's vertex order): what the 2D
      * pictures show. Stored for the cell's own vertices (a tetrahedron's
-     * 4, not a hexahedron's 8: 2 x 64 MB less at 1e6 dofs, on every rank).
+     * 4, not a hexahedron's 8).
      */
     std::vector<double> vertex_stress_yy;
     /** Von Mises stress [Pa] in the same places: the 3D pictures. */
@@ -115,6 +115,7 @@ namespace knee_contact
     {
       return vertex_von_mises[vertex_entry(cell, v)];
     }
+    /** The index of vertex @p v of cell @p cell in the two fields. */
     std::size_t
     vertex_entry(const unsigned int cell, const unsigned int v) const
     {
