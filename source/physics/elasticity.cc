@@ -171,19 +171,20 @@ namespace knee_contact
       // process: 2.85 s with four points, 1.64 with one). A quadrilateral
       // or hexahedron takes the full rule, its volumetric part optionally
       // reduced.
-      const bool simplex =
+      const bool constant_strain =
         cell->reference_cell().is_simplex() && fe.tensor_degree() == 1;
       const bool body_force = with_rhs && !material.body_force_is_zero;
       const FEValues<dim> &stiffness =
-        simplex ? scratch.fe_values_reduced : scratch.fe_values;
-      if (with_matrix && (simplex || material.reduced_volumetric))
+        constant_strain ? scratch.fe_values_reduced : scratch.fe_values;
+      if (with_matrix && (constant_strain || material.reduced_volumetric))
         scratch.fe_values_reduced.reinit(cell);
-      if ((with_matrix && !simplex) || body_force)
+      if ((with_matrix && !constant_strain) || body_force)
         scratch.fe_values.reinit(cell);
       if (with_matrix)
         {
-          const double lambda =
-            material.reduced_volumetric && !simplex ? 0. : material.lambda;
+          const double lambda = material.reduced_volumetric && !constant_strain
+                                  ? 0.
+                                  : material.lambda;
           for (const unsigned int q : stiffness.quadrature_point_indices())
             for (unsigned int i = 0; i < n; ++i)
               {
@@ -218,7 +219,7 @@ namespace knee_contact
             }
         }
 
-      if (with_matrix && material.reduced_volumetric && !simplex)
+      if (with_matrix && material.reduced_volumetric && !constant_strain)
         {
           const FEValues<dim> &fer = scratch.fe_values_reduced;
           for (const unsigned int q : fer.quadrature_point_indices())

@@ -7,15 +7,11 @@
 #include <knee_contact/postprocess/problem_access.h>
 #include <knee_contact/solver/active_set.h>
 
-#include <deal.II/base/geometry_info.h>
-
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/vector.h>
 
 #include <deal.II/dofs/dof_handler.h>
 
-#include <algorithm>
-#include <array>
 #include <map>
 #include <string>
 #include <vector>
@@ -102,8 +98,7 @@ namespace knee_contact
     /** Von Mises stress [Pa] in the same places: the 3D pictures. */
     std::vector<double> vertex_von_mises;
 
-    /** tau_yy at vertex @p v of cell @p cell; past a simplex's last
-     * vertex, its last (as cells.npy repeats it). */
+    /** tau_yy at vertex @p v of cell @p cell. */
     double
     stress_yy_at(const unsigned int cell, const unsigned int v) const
     {
@@ -119,8 +114,8 @@ namespace knee_contact
     std::size_t
     vertex_entry(const unsigned int cell, const unsigned int v) const
     {
-      return std::size_t(cell) * n_cell_vertices +
-             std::min(v, n_cell_vertices - 1);
+      AssertIndexRange(v, n_cell_vertices);
+      return std::size_t(cell) * n_cell_vertices + v;
     }
     /** min and max tau_yy per material id [Pa], at cell vertices. */
     std::map<types::material_id, std::pair<double, double>> stress_yy_range;
