@@ -289,5 +289,47 @@ namespace knee_contact
                   0,
                   MPI_COMM_WORLD);
     }
+
+
+    std::vector<char>
+    scatter_from_first(
+      const std::function<std::vector<char>(unsigned int)> &piece_for)
+    {
+      if (n_ranks() == 1)
+        return piece_for(0);
+      const unsigned long long piece = 1ull << 30;
+      if (rank() == 0)
+        {
+          for (unsigned int r = 1; r < n_ranks(); ++r)
+            {
+              const std::vector<char> bytes = piece_for(r);
+              unsigned long long      size  = bytes.size();
+              MPI_Send(&size, 1, MPI_UNSIGNED_LONG_LONG, r, 0, MPI_COMM_WORLD);
+              for (unsigned long long start = 0; start < size; start += piece)
+                MPI_Send(bytes.data() + start,
+                         int(std::min(piece, size - start)),
+                         MPI_CHAR,
+                         r,
+                         0,
+                         MPI_COMM_WORLD);
+            }
+          return piece_for(0);
+        }
+      unsigned long long size = 0;
+      MPI_Request        request;
+      MPI_Irecv(
+        &size, 1, MPI_UNSIGNED_LONG_LONG, 0, 0, MPI_COMM_WORLD, &request);
+      wait_asleep(request, []() { return false; });
+      std::vector<char> bytes(size);
+      for (unsigned long long start = 0; start < size; start += piece)
+        MPI_Recv(bytes.data() + start,
+                 int(std::min(piece, size - start)),
+                 MPI_CHAR,
+                 0,
+                 0,
+                 MPI_COMM_WORLD,
+                 MPI_STATUS_IGNORE);
+      return bytes;
+    }
   } // namespace parallel
 } // namespace knee_contact

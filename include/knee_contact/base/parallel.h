@@ -3,7 +3,9 @@
 
 #include <mpi.h>
 
+#include <functional>
 #include <string>
+#include <vector>
 
 namespace knee_contact
 {
@@ -81,6 +83,17 @@ namespace knee_contact
      */
     void
     broadcast_from_first(std::string &bytes);
+
+    /**
+     * Rank 0's @p piece_for(r) on rank r: rank 0 makes each rank's piece
+     * and sends it before it makes the next (one piece at a time in its
+     * memory), in messages of at most 1 GB; the others wait asleep, as in
+     * broadcast_from_first(). Returns this rank's piece; @p piece_for is
+     * called on rank 0 only.
+     */
+    std::vector<char>
+    scatter_from_first(
+      const std::function<std::vector<char>(unsigned int)> &piece_for);
   } // namespace parallel
 } // namespace knee_contact
 

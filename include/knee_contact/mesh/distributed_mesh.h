@@ -1,0 +1,59 @@
+#ifndef knee_contact_distributed_mesh_h
+#define knee_contact_distributed_mesh_h
+
+#include <deal.II/distributed/fully_distributed_tria.h>
+#include <deal.II/grid/tria.h>
+
+#include <vector>
+
+namespace knee_contact
+{
+  using namespace dealii;
+
+  /**
+   * A mesh divided over the ranks of a parallel run (issue 38's distributed
+   * stage): each rank holds its cells (a METIS partition of the cells) and
+   * the layer of ghost cells that share a vertex with them, in deal.II's
+   * parallel::fullydistributed::Triangulation, which takes simplices and
+   * hexahedra alike (p4est's takes hexahedra only) and cannot be refined:
+   * a refined mesh is made whole and distributed again, as the
+   * tetrahedral refinement's remeshing already does. Measured at 1e6 DoFs
+   * (doc/parallel.md, "The distributed mesh"): 259 MB of triangulation and
+   * 73 MB of DoFs a rank on two ranks, against 484 and 144 whole.
+   */
+  template <int dim>
+  struct DistributedMesh
+  {
+    /** On the run's ranks (parallel::communicator()). */
+    DistributedMesh();
+
+    dealii::parallel::fullydistributed::Triangulation<dim> triangulation;
+    /**
+     * The body of each cell this rank holds (owned or ghost), by
+     * active_cell_index(): the numbering of the whole mesh's
+     * compute_body_ids(), so that every rank names a body alike.
+     */
+    std::vector<unsigned int> body_of_cell;
+    unsigned int              n_bodies = 0;
+  };
+
+  /**
+   * Divide rank 0's whole, checked mesh @p whole and its bodies
+   * @p whole_body_of_cell (by active_cell_index(); @p n_bodies of them)
+   * over the ranks of the run: rank 0 partitions the cells
+   * (METIS, GridTools::partition_triangulation(), which sets @p whole's
+   * subdomain ids), makes each rank's description (its cells, their ghost
+   * layer and the coarse cells they descend from, with material, boundary
+   * and manifold ids) and sends it; every rank makes its part of the mesh
+   * from it. The other ranks' @p whole and @p whole_body_of_cell are not
+   * read. A collective call.
+   */
+  template <int dim>
+  void
+  distribute_mesh(Triangulation<dim>              &whole,
+                  const std::vector<unsigned int> &whole_body_of_cell,
+                  const unsigned int               n_bodies,
+                  DistributedMesh<dim>            &mesh);
+} // namespace knee_contact
+
+#endif

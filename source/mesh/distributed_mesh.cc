@@ -1,0 +1,103 @@
+#include <knee_contact/base/parallel.h>
+#include <knee_contact/mesh/distributed_mesh.h>
+
+#include <deal.II/base/utilities.h>
+
+#include <deal.II/grid/grid_tools.h>
+#include <deal.II/grid/tria_description.h>
+
+#include <map>
+#include <utility>
+
+namespace knee_contact
+{
+  namespace
+  {
+    /** A rank's part: its description and the bodies of its coarse cells
+     * in the description's order. */
+    template <int dim>
+    using MeshPart = std::pair<TriangulationDescription::Description<dim, dim>,
+                               std::vector<unsigned int>>;
+  } // namespace
+
+
+
+  template <int dim>
+  DistributedMesh<dim>::DistributedMesh()
+    : triangulation(parallel::communicator())
+  {}
+
+
+
+  template <int dim>
+  void
+  distribute_mesh(Triangulation<dim>              &whole,
+                  const std::vector<unsigned int> &whole_body_of_cell,
+                  const unsigned int               n_bodies,
+                  DistributedMesh<dim>            &mesh)
+  {
+    const MPI_Comm     comm  = mesh.triangulation.get_communicator();
+    const unsigned int ranks = Utilities::MPI::n_mpi_processes(comm);
+    // Rank 0: deal.II's partitioner (METIS on the cells' face graph) and
+    // its descriptions; what is written here is only which rank gets which
+    // and the bodies, which deal.II's description does not carry.
+    std::vector<unsigned int> body_of_coarse;
+    if (Utilities::MPI::this_mpi_process(comm) == 0)
+      {
+        GridTools::partition_triangulation(ranks, whole);
+        // A body of the whole mesh by coarse cell: every cell of a coarse
+        // cell's tree is of its body.
+        body_of_coarse.assign(whole.n_cells(0), 0);
+        for (const auto &cell : whole.active_cell_iterators())
+          {
+            auto coarse = cell;
+            while (coarse->level() > 0)
+              coarse = coarse->parent();
+            body_of_coarse[coarse->index()] =
+              whole_body_of_cell.at(cell->active_cell_index());
+          }
+      }
+    std::vector<char> bytes =
+      parallel::scatter_from_first([&](const unsigned int r) {
+        MeshPart<dim> part;
+        part.first = TriangulationDescription::Utilities::
+          create_description_from_triangulation(
+            whole,
+            comm,
+            TriangulationDescription::Settings::default_setting,
+            r);
+        for (const auto id : part.first.coarse_cell_index_to_coarse_cell_id)
+          part.second.push_back(body_of_coarse.at(id));
+        return Utilities::pack(part, false);
+      });
+    MeshPart<dim> part = Utilities::unpack<MeshPart<dim>>(bytes, false);
+    std::vector<char>().swap(bytes);
+    // The bodies by the coarse cell's id, which every cell's CellId starts
+    // with.
+    std::map<types::coarse_cell_id, unsigned int> body_of_id;
+    for (unsigned int i = 0; i < part.second.size(); ++i)
+      body_of_id[part.first.coarse_cell_index_to_coarse_cell_id[i]] =
+        part.second[i];
+    mesh.triangulation.create_triangulation(part.first);
+    mesh.n_bodies = n_bodies;
+    mesh.body_of_cell.assign(mesh.triangulation.n_active_cells(), 0);
+    for (const auto &cell : mesh.triangulation.active_cell_iterators())
+      mesh.body_of_cell[cell->active_cell_index()] =
+        body_of_id.at(cell->id().get_coarse_cell_id());
+  }
+
+
+
+  template struct DistributedMesh<2>;
+  template struct DistributedMesh<3>;
+  template void
+  distribute_mesh(Triangulation<2> &,
+                  const std::vector<unsigned int> &,
+                  const unsigned int,
+                  DistributedMesh<2> &);
+  template void
+  distribute_mesh(Triangulation<3> &,
+                  const std::vector<unsigned int> &,
+                  const unsigned int,
+                  DistributedMesh<3> &);
+} // namespace knee_contact

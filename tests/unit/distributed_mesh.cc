@@ -1,0 +1,231 @@
+// The distributed mesh (issue 38) against the whole mesh it is made from
+// and against the geometry's exact measures, on 2 and 3 ranks: two bodies
+// (a block and a smaller block above it, apart), of triangles and
+// quadrilaterals in 2D, tetrahedra and hexahedra in 3D, each with its
+// material id and boundary ids by the face's place. Asserted, with the
+// tolerance of a sum of cell measures in another order (1e-12 relative):
+// - the cells the ranks own add up to the whole mesh's, every rank owns
+//   some, and every neighbour of a rank's cell is its own or a ghost;
+// - each body's and each material's volume, summed over the cells the
+//   ranks own, is the whole mesh's and the exact one;
+// - each boundary id's measure (faces of owned cells) is the whole mesh's;
+// - every ghost cell carries the body and material id its owner gives it;
+// - the DoFs of the element (linear, one per vertex and component) are
+//   dim times the whole mesh's vertices.
+// Printed by rank 0, the same for any number of ranks.
+
+#include <knee_contact/base/parallel.h>
+#include <knee_contact/mesh/distributed_mesh.h>
+#include <knee_contact/mesh/mesh.h>
+
+#include <deal.II/base/mpi.h>
+
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/fe/fe_q.h>
+#include <deal.II/fe/fe_simplex_p.h>
+#include <deal.II/fe/fe_system.h>
+#include <deal.II/grid/grid_generator.h>
+
+#include <cmath>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <string>
+
+using namespace dealii;
+using namespace knee_contact;
+
+namespace
+{
+  // A block [0,1]^dim-1 x [0,0.5] (material 1) and [0.1,0.9]^dim-1 x
+  // [0.55,1] (material 2); boundary id 10 + 2 axis + side on each body's
+  // faces (the bottom of the upper block is 12 + 2 (dim - 1), say).
+  template <int dim>
+  void
+  make_two_blocks(Triangulation<dim> &whole, const bool simplex)
+  {
+    Point<dim>                lower_a, upper_a, lower_b, upper_b;
+    std::vector<unsigned int> cells_a(dim, 4), cells_b(dim, 3);
+    for (unsigned int d = 0; d + 1 < dim; ++d)
+      {
+        upper_a[d] = 1;
+        lower_b[d] = 0.1;
+        upper_b[d] = 0.9;
+      }
+    upper_a[dim - 1] = 0.5;
+    lower_b[dim - 1] = 0.55;
+    upper_b[dim - 1] = 1;
+    cells_a[dim - 1] = 2;
+    Triangulation<dim> a, b;
+    GridGenerator::subdivided_hyper_rectangle(a, cells_a, lower_a, upper_a);
+    GridGenerator::subdivided_hyper_rectangle(b, cells_b, lower_b, upper_b);
+    for (auto &cell : a.active_cell_iterators())
+      cell->set_material_id(1);
+    for (auto &cell : b.active_cell_iterators())
+      cell->set_material_id(2);
+    Triangulation<dim> blocks;
+    GridGenerator::merge_triangulations(a, b, blocks);
+    if (simplex)
+      GridGenerator::convert_hypercube_to_simplex_mesh(blocks, whole);
+    else
+      whole.copy_triangulation(blocks);
+    for (const auto &cell : whole.active_cell_iterators())
+      for (const auto &face : cell->face_iterators())
+        if (face->at_boundary())
+          {
+            const bool   upper = cell->material_id() == 2;
+            const double lo[2] = {upper ? 0.1 : 0., upper ? 0.55 : 0.};
+            const double hi[2] = {upper ? 0.9 : 1., upper ? 1. : 0.5};
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                const bool   vertical = d + 1 == dim;
+                const double x        = face->center()[d];
+                if (std::abs(x - lo[vertical]) < 1e-9)
+                  face->set_boundary_id(10 + 2 * d);
+                else if (std::abs(x - hi[vertical]) < 1e-9)
+                  face->set_boundary_id(11 + 2 * d);
+              }
+          }
+  }
+
+  struct Measures
+  {
+    std::map<unsigned int, double> body, material, boundary;
+  };
+
+  template <int dim>
+  Measures
+  measures(const Triangulation<dim>        &tria,
+           const std::vector<unsigned int> &body_of_cell)
+  {
+    Measures m;
+    for (const auto &cell : tria.active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          m.body[body_of_cell[cell->active_cell_index()]] += cell->measure();
+          m.material[cell->material_id()] += cell->measure();
+          for (const auto &face : cell->face_iterators())
+            if (face->at_boundary())
+              m.boundary[face->boundary_id()] += face->measure();
+        }
+    return m;
+  }
+
+  bool
+  close(const double a, const double b)
+  {
+    return std::abs(a - b) <= 1e-12 * std::max(std::abs(a), std::abs(b));
+  }
+
+  std::string
+  compare(const std::map<unsigned int, double> &whole,
+          const std::map<unsigned int, double> &mine,
+          const MPI_Comm                        comm)
+  {
+    bool same = true;
+    for (const auto &[id, value] : whole)
+      {
+        const auto   it = mine.find(id);
+        const double sum =
+          Utilities::MPI::sum(it == mine.end() ? 0. : it->second, comm);
+        same &= close(sum, value);
+      }
+    // No id the whole mesh does not have.
+    for (const auto &part : Utilities::MPI::all_gather(comm, mine))
+      for (const auto &[id, value] : part)
+        same &= whole.count(id) == 1;
+    return same ? "equal" : "DIFFERENT";
+  }
+
+  template <int dim>
+  void
+  check(const bool simplex)
+  {
+    const MPI_Comm     comm = knee_contact::parallel::communicator();
+    Triangulation<dim> whole;
+    make_two_blocks(whole, simplex);
+    unsigned int                    n_bodies = 0;
+    const std::vector<unsigned int> whole_body =
+      compute_body_ids(whole, n_bodies);
+    const Measures reference = measures(whole, whole_body);
+
+    DistributedMesh<dim> mesh;
+    distribute_mesh(whole, whole_body, n_bodies, mesh);
+    const auto        &tria  = mesh.triangulation;
+    const Measures     mine  = measures(tria, mesh.body_of_cell);
+    const unsigned int owned = tria.n_locally_owned_active_cells();
+    // The ghost layer: every neighbour of an owned cell is here.
+    bool layer = true;
+    for (const auto &cell : tria.active_cell_iterators())
+      if (cell->is_locally_owned())
+        for (const unsigned int f : cell->face_indices())
+          if (!cell->at_boundary(f))
+            layer &= cell->neighbor(f)->is_locally_owned() ||
+                     cell->neighbor(f)->is_ghost();
+    // Every ghost's body and material as its owner gives them.
+    std::map<std::string, std::pair<unsigned int, unsigned int>> of_owned;
+    for (const auto &cell : tria.active_cell_iterators())
+      if (cell->is_locally_owned())
+        of_owned[cell->id().to_string()] = {
+          mesh.body_of_cell[cell->active_cell_index()], cell->material_id()};
+    bool       ghosts_agree = true;
+    const auto all_owned    = Utilities::MPI::all_gather(comm, of_owned);
+    for (const auto &cell : tria.active_cell_iterators())
+      if (cell->is_ghost())
+        {
+          const auto &of_owner =
+            all_owned[cell->subdomain_id()].at(cell->id().to_string());
+          ghosts_agree &=
+            of_owner.first == mesh.body_of_cell[cell->active_cell_index()] &&
+            of_owner.second == cell->material_id();
+        }
+
+    std::unique_ptr<FiniteElement<dim>> fe;
+    if (simplex)
+      fe = std::make_unique<FESystem<dim>>(FE_SimplexP<dim>(1), dim);
+    else
+      fe = std::make_unique<FESystem<dim>>(FE_Q<dim>(1), dim);
+    DoFHandler<dim> dofs(tria);
+    dofs.distribute_dofs(*fe);
+
+    const double       upper     = dim == 2 ? 0.8 * 0.45 : 0.8 * 0.8 * 0.45;
+    const double       lower     = 0.5;
+    const unsigned int min_owned = Utilities::MPI::min(owned, comm);
+    const bool         has_layer = Utilities::MPI::min(int(layer), comm) == 1;
+    const unsigned int sum_owned = Utilities::MPI::sum(owned, comm);
+    const bool        agree = Utilities::MPI::min(int(ghosts_agree), comm) == 1;
+    const std::string bodies = compare(reference.body, mine.body, comm);
+    const std::string material =
+      compare(reference.material, mine.material, comm);
+    const std::string boundary =
+      compare(reference.boundary, mine.boundary, comm);
+    if (knee_contact::parallel::rank() == 0)
+      std::cout << dim << "D " << (simplex ? "simplex" : "hypercube")
+                << ": cells owned " << sum_owned << " of "
+                << whole.n_active_cells() << ", every rank owns some "
+                << (min_owned > 0 ? "yes" : "NO")
+                << ", owned cells' neighbours owned or ghosts "
+                << (has_layer ? "yes" : "NO") << "\n  bodies " << n_bodies
+                << " " << bodies << ", volumes exact "
+                << (close(reference.material.at(1), lower) &&
+                        close(reference.material.at(2), upper)
+                      ? "yes"
+                      : "NO")
+                << ", materials " << material << ", boundary ids "
+                << reference.boundary.size() << " " << boundary
+                << "\n  ghosts' bodies and materials those of their owners "
+                << (agree ? "yes" : "NO") << ", dofs " << dofs.n_dofs()
+                << (dofs.n_dofs() == dim * whole.n_vertices() ? " = " : " != ")
+                << "dim x vertices" << std::endl;
+  }
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
+  check<2>(true);
+  check<2>(false);
+  check<3>(true);
+  check<3>(false);
+}
