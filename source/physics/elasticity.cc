@@ -153,12 +153,16 @@ namespace knee_contact
       const Material<dim>      &material = materials[cell->material_id()];
       copy.dof_indices.resize(n);
       cell->get_dof_indices(copy.dof_indices);
-      copy.skipped = sinks.wanted != nullptr &&
+      // On a distributed mesh (DistributedMesh) a rank assembles the cells
+      // it owns, not its ghosts: their owners do (a whole mesh's cells are
+      // all owned).
+      copy.skipped = !cell->is_locally_owned() ||
+                     (sinks.wanted != nullptr &&
                      std::none_of(copy.dof_indices.begin(),
                                   copy.dof_indices.end(),
                                   [&](const types::global_dof_index i) {
                                     return (*sinks.wanted)(i);
-                                  });
+                                  }));
       if (copy.skipped)
         return;
       copy.cell_matrix.reinit(n, n);

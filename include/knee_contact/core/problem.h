@@ -128,6 +128,11 @@ namespace knee_contact
     {
       return materials;
     }
+    const BoundaryConditions<dim> &
+    boundary_conditions_of() const
+    {
+      return boundary_conditions;
+    }
     const DoFHandler<dim> &
     dof_handler_of() const
     {

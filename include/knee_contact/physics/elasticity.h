@@ -53,7 +53,8 @@ namespace knee_contact
      * each given to @p add(dofs, cell matrix) as it is made (one call at
      * a time; the cells in parallel by WorkStream): the rows a rank holds
      * of C, summed where they are kept (IterativeContactSystem on several
-     * ranks), without C whole.
+     * ranks), without C whole. On a distributed mesh (DistributedMesh):
+     * of the cells this rank owns.
      */
     void
     assemble_cells(

@@ -1,0 +1,161 @@
+// The elastic stiffness C assembled on the distributed mesh (issue 38)
+// against C of the whole mesh, on 2 and 3 ranks: each scene is run as a
+// whole on every rank (its direct path holds C whole), its mesh is
+// distributed (distribute_mesh()), the DoFs numbered on the distributed
+// mesh, and ElasticityAssembler::assemble_cells() adds the cells each rank
+// owns into a Trilinos matrix whose rows the ranks own (a ghost row's
+// entries sent to its owner). The scene's solution x, carried to the new
+// numbering by vertex position (every element is linear: its dofs sit at
+// the vertices), gives C x on both. Asserted, to 1e-12 relative to the
+// largest entry (a sum of the same cell matrices in another order): every
+// owned row of C x, and the energy x^T C x. Scenes: 3D tetrahedra (the
+// contact patch), 3D hexahedra and 2D quadrilaterals (the QP scenes), two
+// bodies each. Printed by rank 0, the same for any number of ranks.
+
+#include <knee_contact/base/parallel.h>
+#include <knee_contact/core/problem.h>
+#include <knee_contact/mesh/distributed_mesh.h>
+#include <knee_contact/mesh/mesh.h>
+#include <knee_contact/physics/elasticity.h>
+
+#include <deal.II/base/mpi.h>
+
+#include <deal.II/lac/trilinos_sparse_matrix.h>
+#include <deal.II/lac/trilinos_sparsity_pattern.h>
+#include <deal.II/lac/trilinos_vector.h>
+
+#include <deal.II/dofs/dof_tools.h>
+
+#include <array>
+#include <cmath>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <string>
+
+using namespace dealii;
+using namespace knee_contact;
+
+namespace
+{
+  // A vertex by its body and position: the bodies' surfaces in contact
+  // share positions.
+  template <int dim>
+  std::array<double, dim + 1>
+  key(const unsigned int body, const Point<dim> &p)
+  {
+    std::array<double, dim + 1> k;
+    k[0] = body;
+    for (unsigned int d = 0; d < dim; ++d)
+      k[d + 1] = p[d];
+    return k;
+  }
+
+  template <int dim>
+  void
+  check(const std::string &scene)
+  {
+    const MPI_Comm      comm = knee_contact::parallel::communicator();
+    ContactProblem<dim> problem(SOURCE_DIR "/" + scene);
+    {
+      // The run's own report is checked by its scene test, not here.
+      std::ostringstream report;
+      std::streambuf    *out  = std::cout.rdbuf(report.rdbuf());
+      const int          code = problem.run();
+      std::cout.rdbuf(out);
+      AssertThrow(code == 0, ExcMessage(scene + " failed"));
+    }
+    const DoFHandler<dim> &whole_dofs = problem.dof_handler_of();
+    const Vector<double>  &x          = problem.solution();
+    Vector<double>         Cx(x.size());
+    problem.matrix().vmult(Cx, x);
+    double x_C_x = x * Cx;
+
+    // The whole mesh's dofs by body and vertex position (the distributed
+    // mesh's vertices are copies of these, bit for bit).
+    Triangulation<dim> whole;
+    whole.copy_triangulation(whole_dofs.get_triangulation());
+    unsigned int                    n_bodies = 0;
+    const std::vector<unsigned int> bodies = compute_body_ids(whole, n_bodies);
+    std::map<std::array<double, dim + 1>,
+             std::array<types::global_dof_index, dim>>
+      dofs_at;
+    for (const auto &cell : whole_dofs.active_cell_iterators())
+      for (const unsigned int v : cell->vertex_indices())
+        for (unsigned int d = 0; d < dim; ++d)
+          dofs_at[key(bodies[cell->active_cell_index()], cell->vertex(v))][d] =
+            cell->vertex_dof_index(v, d);
+    DistributedMesh<dim> mesh;
+    distribute_mesh(whole, bodies, n_bodies, mesh);
+    DoFHandler<dim> dofs(mesh.triangulation);
+    dofs.distribute_dofs(whole_dofs.get_fe());
+    const IndexSet owned = dofs.locally_owned_dofs();
+    IndexSet       relevant;
+    DoFTools::extract_locally_relevant_dofs(dofs, relevant);
+
+    TrilinosWrappers::SparsityPattern pattern(owned, owned, relevant, comm);
+    DoFTools::make_sparsity_pattern(dofs,
+                                    pattern,
+                                    AffineConstraints<double>(),
+                                    false,
+                                    Utilities::MPI::this_mpi_process(comm));
+    pattern.compress();
+    TrilinosWrappers::SparseMatrix C;
+    C.reinit(pattern);
+    ElasticityAssembler<dim>(problem.materials_of(),
+                             problem.boundary_conditions_of())
+      .assemble_cells(
+        dofs,
+        [](const types::global_dof_index) { return true; },
+        [&](const std::vector<types::global_dof_index> &indices,
+            const FullMatrix<double>                   &cell_matrix) {
+          C.add(indices, cell_matrix);
+        });
+    C.compress(VectorOperation::add);
+
+    // x in the distributed numbering, then C x there.
+    TrilinosWrappers::MPI::Vector x_here(owned, comm), Cx_here(owned, comm);
+    std::map<types::global_dof_index, types::global_dof_index> whole_of;
+    for (const auto &cell : dofs.active_cell_iterators())
+      if (cell->is_locally_owned())
+        for (const unsigned int v : cell->vertex_indices())
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              const auto i = cell->vertex_dof_index(v, d);
+              whole_of[i] =
+                dofs_at.at(key(mesh.body_of_cell[cell->active_cell_index()],
+                               cell->vertex(v)))[d];
+              if (owned.is_element(i))
+                x_here(i) = x(whole_of[i]);
+            }
+    x_here.compress(VectorOperation::insert);
+    C.vmult(Cx_here, x_here);
+    double largest = Cx.linfty_norm(), difference = 0;
+    for (const auto i : owned)
+      difference =
+        std::max(difference, std::abs(Cx_here(i) - Cx(whole_of.at(i))));
+    difference          = Utilities::MPI::max(difference, comm);
+    const double energy = x_here * Cx_here;
+    const auto   n_owned =
+      Utilities::MPI::sum(static_cast<unsigned int>(owned.n_elements()), comm);
+    if (knee_contact::parallel::rank() == 0)
+      std::cout << scene << ": " << n_owned << " rows owned of "
+                << dofs.n_dofs() << " (whole: " << x.size() << ")\n"
+                << "  C x on the distributed mesh against the whole mesh's: "
+                << (difference <= 1e-12 * largest ? "equal" : "DIFFERENT")
+                << " to 1e-12 of max |C x|; x^T C x "
+                << (std::abs(energy - x_C_x) <= 1e-12 * std::abs(x_C_x)
+                      ? "equal"
+                      : "DIFFERENT")
+                << " to 1e-12" << std::endl;
+  }
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
+  check<3>("../scenes/contact_patch_3d_tet.prm");
+  check<3>("qp_scene_3d.prm");
+  check<2>("qp_scene.prm");
+}
