@@ -158,11 +158,11 @@ namespace knee_contact
       // all owned).
       copy.skipped = !cell->is_locally_owned() ||
                      (sinks.wanted != nullptr &&
-                     std::none_of(copy.dof_indices.begin(),
-                                  copy.dof_indices.end(),
-                                  [&](const types::global_dof_index i) {
-                                    return (*sinks.wanted)(i);
-                                  }));
+                      std::none_of(copy.dof_indices.begin(),
+                                   copy.dof_indices.end(),
+                                   [&](const types::global_dof_index i) {
+                                     return (*sinks.wanted)(i);
+                                   }));
       if (copy.skipped)
         return;
       copy.cell_matrix.reinit(n, n);
