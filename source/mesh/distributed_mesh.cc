@@ -7,17 +7,20 @@
 #include <deal.II/grid/tria_description.h>
 
 #include <map>
+#include <tuple>
 #include <utility>
 
 namespace knee_contact
 {
   namespace
   {
-    /** A rank's part: its description and the bodies of its coarse cells
-     * in the description's order. */
+    /** A rank's part: its description, the bodies of its coarse cells and
+     * the whole mesh's indices of its coarse vertices, in the description's
+     * order. */
     template <int dim>
-    using MeshPart = std::pair<TriangulationDescription::Description<dim, dim>,
-                               std::vector<unsigned int>>;
+    using MeshPart = std::tuple<TriangulationDescription::Description<dim, dim>,
+                                std::vector<unsigned int>,
+                                std::vector<unsigned int>>;
   } // namespace
 
 
@@ -60,30 +63,57 @@ namespace knee_contact
     std::vector<char> bytes =
       parallel::scatter_from_first([&](const unsigned int r) {
         MeshPart<dim> part;
-        part.first = TriangulationDescription::Utilities::
+        auto &[description, bodies, vertex_ids] = part;
+        description = TriangulationDescription::Utilities::
           create_description_from_triangulation(
             whole,
             comm,
             TriangulationDescription::Settings::default_setting,
             r);
-        for (const auto id : part.first.coarse_cell_index_to_coarse_cell_id)
-          part.second.push_back(body_of_coarse.at(id));
+        // A coarse cell's vertices in the description are those of the
+        // whole mesh's cell of its id, in the same order.
+        vertex_ids.assign(description.coarse_cell_vertices.size(),
+                          numbers::invalid_unsigned_int);
+        for (unsigned int c = 0; c < description.coarse_cells.size(); ++c)
+          {
+            const auto id = description.coarse_cell_index_to_coarse_cell_id[c];
+            bodies.push_back(body_of_coarse.at(id));
+            const typename Triangulation<dim>::cell_iterator cell(&whole,
+                                                                  0,
+                                                                  id);
+            const auto &local = description.coarse_cells[c].vertices;
+            for (unsigned int v = 0; v < local.size(); ++v)
+              vertex_ids.at(local[v]) = cell->vertex_index(v);
+          }
         return Utilities::pack(part, false);
       });
     MeshPart<dim> part = Utilities::unpack<MeshPart<dim>>(bytes, false);
     std::vector<char>().swap(bytes);
+    const auto &[description, bodies, vertex_ids] = part;
     // The bodies by the coarse cell's id, which every cell's CellId starts
     // with.
     std::map<types::coarse_cell_id, unsigned int> body_of_id;
-    for (unsigned int i = 0; i < part.second.size(); ++i)
-      body_of_id[part.first.coarse_cell_index_to_coarse_cell_id[i]] =
-        part.second[i];
-    mesh.triangulation.create_triangulation(part.first);
+    for (unsigned int i = 0; i < bodies.size(); ++i)
+      body_of_id[description.coarse_cell_index_to_coarse_cell_id[i]] =
+        bodies[i];
+    mesh.triangulation.create_triangulation(description);
     mesh.n_bodies = n_bodies;
     mesh.body_of_cell.assign(mesh.triangulation.n_active_cells(), 0);
     for (const auto &cell : mesh.triangulation.active_cell_iterators())
       mesh.body_of_cell[cell->active_cell_index()] =
         body_of_id.at(cell->id().get_coarse_cell_id());
+    // The mesh keeps the description's vertices in its order (checked, not
+    // documented by deal.II); refinement's vertices have no whole index.
+    mesh.vertex_id.assign(mesh.triangulation.n_vertices(),
+                          numbers::invalid_unsigned_int);
+    const auto &points = mesh.triangulation.get_vertices();
+    AssertThrow(points.size() >= vertex_ids.size(), ExcInternalError());
+    for (unsigned int v = 0; v < vertex_ids.size(); ++v)
+      {
+        AssertThrow(points[v] == description.coarse_cell_vertices[v],
+                    ExcInternalError());
+        mesh.vertex_id[v] = vertex_ids[v];
+      }
   }
 
 

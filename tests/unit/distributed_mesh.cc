@@ -10,6 +10,8 @@
 //   ranks own, is the whole mesh's and the exact one;
 // - each boundary id's measure (faces of owned cells) is the whole mesh's;
 // - every ghost cell carries the body and material id its owner gives it;
+// - every vertex a rank holds names the whole mesh's vertex at its place,
+//   no two the same;
 // - the DoFs of the element (linear, one per vertex and component) are
 //   dim times the whole mesh's vertices.
 // Printed by rank 0, the same for any number of ranks.
@@ -30,6 +32,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 
 using namespace dealii;
@@ -180,6 +183,20 @@ namespace
             of_owner.second == cell->material_id();
         }
 
+    // Every vertex here names the whole mesh's vertex at its place, and
+    // no two the same.
+    bool                   ids_agree = true;
+    std::set<unsigned int> ids;
+    for (unsigned int v = 0; v < tria.n_vertices(); ++v)
+      if (tria.get_used_vertices()[v])
+        {
+          const unsigned int id = mesh.vertex_id[v];
+          ids_agree &= id < whole.n_vertices() &&
+                       whole.get_vertices()[id] == tria.get_vertices()[v] &&
+                       ids.insert(id).second;
+        }
+    ids_agree = Utilities::MPI::min(int(ids_agree), comm) == 1;
+
     std::unique_ptr<FiniteElement<dim>> fe;
     if (simplex)
       fe = std::make_unique<FESystem<dim>>(FE_SimplexP<dim>(1), dim);
@@ -214,7 +231,8 @@ namespace
                 << ", materials " << material << ", boundary ids "
                 << reference.boundary.size() << " " << boundary
                 << "\n  ghosts' bodies and materials those of their owners "
-                << (agree ? "yes" : "NO") << ", dofs " << dofs.n_dofs()
+                << (agree ? "yes" : "NO") << ", vertices name the whole mesh's "
+                << (ids_agree ? "yes" : "NO") << "\n  dofs " << dofs.n_dofs()
                 << (dofs.n_dofs() == dim * whole.n_vertices() ? " = " : " != ")
                 << "dim x vertices" << std::endl;
   }

@@ -35,6 +35,12 @@ namespace knee_contact
      */
     std::vector<unsigned int> body_of_cell;
     unsigned int              n_bodies = 0;
+    /**
+     * The whole mesh's index of each vertex this rank holds (by its index
+     * here), so that every rank names a vertex alike (the contact sides'
+     * keys); invalid for a vertex a refinement of the whole mesh made.
+     */
+    std::vector<unsigned int> vertex_id;
   };
 
   /**
