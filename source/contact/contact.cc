@@ -3,6 +3,8 @@
 #include <knee_contact/contact/contact_sides.h>
 #include <knee_contact/contact/face_geometry.h>
 
+#include <deal.II/base/mpi.h>
+
 #include <deal.II/lac/vector.h>
 
 #include <algorithm>
@@ -281,18 +283,115 @@ namespace knee_contact
 
     // Faces that are neither segments, triangles nor quadrilaterals cannot
     // occur in deal.II's meshes; 3D faces carry 3 or 4 vertices.
+    /**
+     * A distributed mesh's sides: every rank's faces (those of the cells
+     * it owns) on every rank, rank by rank, and the slave vertices' sums
+     * (normal, weight) over the ranks' faces. Flattened to doubles for
+     * one all-gather (indices, keys and counts are below 2^53).
+     */
+    template <int dim>
+    void
+    gather_sides(ContactSides<dim> &sides, const MPI_Comm comm)
+    {
+      using Face = typename ContactSides<dim>::Face;
+      std::vector<double> mine;
+      const auto          put_face = [&](const Face &face) {
+        mine.push_back(face.n_vertices);
+        for (unsigned int v = 0; v < Face::max_vertices; ++v)
+          {
+            mine.push_back(face.vertex_keys[v]);
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                mine.push_back(face.vertices[v][d]);
+                mine.push_back(face.dofs[v][d]);
+              }
+          }
+        for (unsigned int d = 0; d < dim; ++d)
+          mine.push_back(face.normal[d]);
+        mine.push_back(face.measure);
+        mine.push_back(face.diameter);
+      };
+      mine.push_back(sides.slaves.size());
+      for (const auto &[key, slave] : sides.slaves)
+        {
+          mine.push_back(key);
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              mine.push_back(slave.position[d]);
+              mine.push_back(slave.normal[d]);
+              mine.push_back(slave.dofs[d]);
+            }
+          mine.push_back(slave.length);
+        }
+      for (const auto *faces : {&sides.slave_faces, &sides.master_faces})
+        {
+          mine.push_back(faces->size());
+          for (const Face &face : *faces)
+            put_face(face);
+        }
+
+      ContactSides<dim> all;
+      all.min_length = std::numeric_limits<double>::max();
+      for (const auto &theirs : Utilities::MPI::all_gather(comm, mine))
+        {
+          std::size_t at    = 0;
+          const auto  next  = [&]() { return theirs.at(at++); };
+          const auto  index = [&]() {
+            return static_cast<types::global_dof_index>(next());
+          };
+          for (std::size_t n = index(); n > 0; --n)
+            {
+              auto &slave = all.slaves[static_cast<unsigned int>(next())];
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  slave.position[d] = next();
+                  slave.normal[d] += next();
+                  slave.dofs[d] = index();
+                }
+              slave.length += next();
+            }
+          for (auto *faces : {&all.slave_faces, &all.master_faces})
+            for (std::size_t n = index(); n > 0; --n)
+              {
+                Face face;
+                face.n_vertices = index();
+                for (unsigned int v = 0; v < Face::max_vertices; ++v)
+                  {
+                    face.vertex_keys[v] = index();
+                    for (unsigned int d = 0; d < dim; ++d)
+                      {
+                        face.vertices[v][d] = next();
+                        face.dofs[v][d]     = index();
+                      }
+                  }
+                for (unsigned int d = 0; d < dim; ++d)
+                  face.normal[d] = next();
+                face.measure  = next();
+                face.diameter = next();
+                if (faces == &all.slave_faces)
+                  all.min_length =
+                    std::min(all.min_length,
+                             dim == 2 ? face.measure : face.diameter);
+                faces->push_back(face);
+              }
+        }
+      sides = std::move(all);
+    }
+
     template <int dim>
     ContactSides<dim>
     collect_sides(const DoFHandler<dim>           &dof_handler,
                   const ContactInterface          &interface,
-                  const AffineConstraints<double> &constraints)
+                  const AffineConstraints<double> &constraints,
+                  const std::vector<unsigned int> *vertex_id)
     {
       using Face = typename ContactSides<dim>::Face;
       ContactSides<dim> sides;
       sides.min_length = std::numeric_limits<double>::max();
+      // A distributed mesh's ghosts are their owners' to collect.
       for (const auto &cell : dof_handler.active_cell_iterators())
         for (const unsigned int f : cell->face_indices())
-          if (cell->face(f)->at_boundary() &&
+          if (cell->is_locally_owned() && cell->face(f)->at_boundary() &&
               (cell->face(f)->boundary_id() == interface.slave_id ||
                cell->face(f)->boundary_id() == interface.master_id))
             {
@@ -304,7 +403,9 @@ namespace knee_contact
                           ExcInternalError());
               for (unsigned int v = 0; v < side.n_vertices; ++v)
                 {
-                  side.vertex_keys[v] = face->vertex_index(v);
+                  side.vertex_keys[v] = vertex_id != nullptr
+                                          ? vertex_id->at(face->vertex_index(v))
+                                          : face->vertex_index(v);
                   side.vertices[v]    = face->vertex(v);
                   for (unsigned int d = 0; d < dim; ++d)
                     side.dofs[v][d] = face->vertex_dof_index(v, d);
@@ -337,6 +438,8 @@ namespace knee_contact
               else
                 sides.master_faces.push_back(side);
             }
+      if (vertex_id != nullptr)
+        gather_sides(sides, dof_handler.get_triangulation().get_communicator());
       // 3D: hanging slave vertices, their x component's line referring to
       // the x components of other slave vertices only.
       if constexpr (dim == 3)
@@ -372,7 +475,8 @@ namespace knee_contact
   ContactPairs<dim>
   ContactInterfaces::make_pairs(
     const DoFHandler<dim>           &dof_handler,
-    const AffineConstraints<double> &constraints) const
+    const AffineConstraints<double> &constraints,
+    const std::vector<unsigned int> *vertex_id) const
   {
     ContactPairs<dim>                 pairs;
     std::set<types::global_dof_index> eliminated;
@@ -392,7 +496,7 @@ namespace knee_contact
       {
         const ContactInterface &interface = list[i];
         const ContactSides<dim> sides =
-          collect_sides<dim>(dof_handler, interface, constraints);
+          collect_sides<dim>(dof_handler, interface, constraints, vertex_id);
         const std::string where = "Contact/Interface " + std::to_string(i) +
                                   " ('" + interface.name + "'): ";
         AssertThrow(!sides.slaves.empty() && !sides.master_faces.empty(),
@@ -600,10 +704,12 @@ namespace knee_contact
 
   template ContactPairs<2>
   ContactInterfaces::make_pairs(const DoFHandler<2> &,
-                                const AffineConstraints<double> &) const;
+                                const AffineConstraints<double> &,
+                                const std::vector<unsigned int> *) const;
   template ContactPairs<3>
   ContactInterfaces::make_pairs(const DoFHandler<3> &,
-                                const AffineConstraints<double> &) const;
+                                const AffineConstraints<double> &,
+                                const std::vector<unsigned int> *) const;
   template void
   ContactInterfaces::check_mesh(const Triangulation<2> &,
                                 const std::vector<unsigned int> &) const;

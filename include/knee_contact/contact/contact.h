@@ -253,11 +253,20 @@ namespace knee_contact
      * choose each row's eliminated dof given the Gamma_u/Gamma_o
      * @p constraints (closed). 2D and 3D, with friction the tangential and
      * stick rows too.
+     *
+     * On a distributed mesh (DistributedMesh) @p vertex_id names each
+     * vertex a rank holds by the whole mesh's index: each rank collects the
+     * sides' faces of the cells it owns and every rank gathers them all
+     * (the sides are a surface's worth), keyed as the whole mesh keys
+     * them, so that every rank makes the same rows, in the whole mesh's
+     * order, on the distributed dofs; @p constraints must then hold the
+     * lines of every dof of the sides. Null on a whole mesh.
      */
     template <int dim>
     ContactPairs<dim>
     make_pairs(const DoFHandler<dim>           &dof_handler,
-               const AffineConstraints<double> &constraints) const;
+               const AffineConstraints<double> &constraints,
+               const std::vector<unsigned int> *vertex_id = nullptr) const;
 
     const std::vector<ContactInterface> &
     interfaces() const

@@ -133,6 +133,11 @@ namespace knee_contact
     {
       return boundary_conditions;
     }
+    const ContactInterfaces &
+    contact_interfaces_of() const
+    {
+      return contact_interfaces;
+    }
     const DoFHandler<dim> &
     dof_handler_of() const
     {

@@ -1,18 +1,29 @@
-// The elastic stiffness C assembled on the distributed mesh (issue 38)
-// against C of the whole mesh, on 2 and 3 ranks: each scene is run as a
-// whole on every rank (its direct path holds C whole), its mesh is
-// distributed (distribute_mesh()), the DoFs numbered on the distributed
-// mesh, and ElasticityAssembler::assemble_cells() adds the cells each rank
-// owns into a Trilinos matrix whose rows the ranks own (a ghost row's
-// entries sent to its owner). The scene's solution x, carried to the new
-// numbering by vertex position (every element is linear: its dofs sit at
-// the vertices), gives C x on both. Asserted, to 1e-12 relative to the
-// largest entry (a sum of the same cell matrices in another order): every
-// owned row of C x, and the energy x^T C x. Scenes: 3D tetrahedra (the
-// contact patch), 3D hexahedra and 2D quadrilaterals (the QP scenes), two
-// bodies each. Printed by rank 0, the same for any number of ranks.
+// The elastic stiffness C and the contact rows made on the distributed mesh
+// (issue 38) against those of the whole mesh, on 2 and 3 ranks: each scene
+// is run as a whole on every rank (its direct path holds C whole), its mesh
+// is distributed (distribute_mesh()), the DoFs numbered on the distributed
+// mesh, and
+// - ElasticityAssembler::assemble_cells() adds the cells each rank owns
+//   into a Trilinos matrix whose rows the ranks own (a ghost row's entries
+//   sent to its owner). The scene's solution x, carried to the new
+//   numbering by body and vertex position (every element is linear: its
+//   dofs sit at the vertices), gives C x on both. Asserted, to 1e-12
+//   relative to the largest entry (a sum of the same cell matrices in
+//   another order): every owned row of C x, and the energy x^T C x;
+// - ContactInterfaces::make_pairs() collects the sides from the faces of
+//   the cells each rank owns and gathers them (keyed by the whole mesh's
+//   vertex indices), with the scene's Gamma_u and Gamma_o lines carried to
+//   the new numbering. Asserted on every rank: the same rows in the same
+//   order, each row's slave position, gap, weight, entries (dofs carried
+//   back) and the same after the lines' substitution, to 1e-12 relative to
+//   the row's largest, and the same eliminated dof.
+// Scenes: 3D tetrahedra (the contact patch: mortar), 3D hexahedra (the QP
+// scene: mortar, non-matching) and 2D quadrilaterals (the QP scene:
+// node-to-segment), two bodies each. Printed by rank 0, the same for any
+// number of ranks.
 
 #include <knee_contact/base/parallel.h>
+#include <knee_contact/contact/contact.h>
 #include <knee_contact/core/problem.h>
 #include <knee_contact/mesh/distributed_mesh.h>
 #include <knee_contact/mesh/mesh.h>
@@ -136,7 +147,70 @@ namespace
         std::max(difference, std::abs(Cx_here(i) - Cx(whole_of.at(i))));
     difference          = Utilities::MPI::max(difference, comm);
     const double energy = x_here * Cx_here;
-    const auto   n_owned =
+
+    // The contact rows. The whole numbering of every dof here, on every
+    // rank, and the scene's lines in this numbering.
+    std::map<types::global_dof_index, types::global_dof_index> here_of;
+    for (const auto &part : Utilities::MPI::all_gather(comm, whole_of))
+      for (const auto &[i, w] : part)
+        {
+          whole_of[i] = w;
+          here_of[w]  = i;
+        }
+    AffineConstraints<double> lines;
+    for (const auto &line : problem.base_constraints().get_lines())
+      {
+        const auto i = here_of.at(line.index);
+        lines.add_line(i);
+        for (const auto &[j, c] : line.entries)
+          lines.add_entry(i, here_of.at(j), c);
+        lines.set_inhomogeneity(i, line.inhomogeneity);
+      }
+    lines.close();
+    const ContactPairs<dim> pairs =
+      problem.contact_interfaces_of().make_pairs(dofs, lines, &mesh.vertex_id);
+    const ContactPairs<dim> &reference = problem.pairs();
+    const auto same = [](const double a, const double b, const double scale) {
+      return std::abs(a - b) <= 1e-12 * scale;
+    };
+    const auto same_entries =
+      [&](
+        const std::vector<std::pair<types::global_dof_index, double>> &here,
+        const std::vector<std::pair<types::global_dof_index, double>> &whole) {
+        std::map<types::global_dof_index, double> a, b;
+        double                                    scale = 1e-300;
+        for (const auto &[i, c] : here)
+          a[whole_of.at(i)] = c;
+        for (const auto &[i, c] : whole)
+          {
+            b[i]  = c;
+            scale = std::max(scale, std::abs(c));
+          }
+        bool equal = a.size() == b.size();
+        for (const auto &[i, c] : b)
+          equal &= a.count(i) == 1 && same(a[i], c, scale);
+        return equal;
+      };
+    bool rows_agree = pairs.size() == reference.size();
+    for (unsigned int p = 0; rows_agree && p < pairs.size(); ++p)
+      {
+        const ContactRow &here = pairs.rows[p], &whole = reference.rows[p];
+        const double      size =
+          std::max(std::abs(whole.gap), pairs.points[p].position.norm());
+        rows_agree &= pairs.points[p].position.distance(
+                        reference.points[p].position) <= 1e-12 * size &&
+                      same(here.gap, whole.gap, size) &&
+                      same(here.length, whole.length, whole.length) &&
+                      same(here.reduced_gap, whole.reduced_gap, size) &&
+                      same_entries(here.row, whole.row) &&
+                      same_entries(here.reduced_row, whole.reduced_row) &&
+                      (here.eliminated == numbers::invalid_dof_index
+                         ? whole.eliminated == numbers::invalid_dof_index
+                         : whole_of.at(here.eliminated) == whole.eliminated) &&
+                      here.slave_eliminated == whole.slave_eliminated;
+      }
+    rows_agree = Utilities::MPI::min(int(rows_agree), comm) == 1;
+    const auto n_owned =
       Utilities::MPI::sum(static_cast<unsigned int>(owned.n_elements()), comm);
     if (knee_contact::parallel::rank() == 0)
       std::cout << scene << ": " << n_owned << " rows owned of "
@@ -147,7 +221,10 @@ namespace
                 << (std::abs(energy - x_C_x) <= 1e-12 * std::abs(x_C_x)
                       ? "equal"
                       : "DIFFERENT")
-                << " to 1e-12" << std::endl;
+                << " to 1e-12\n  contact rows (" << reference.size()
+                << ") on the distributed mesh: "
+                << (rows_agree ? "those of the whole mesh" : "DIFFERENT")
+                << std::endl;
   }
 } // namespace
 
