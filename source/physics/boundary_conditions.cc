@@ -2,6 +2,9 @@
 #include <knee_contact/physics/boundary_conditions.h>
 #include <knee_contact/physics/elements.h>
 
+#include <deal.II/base/mpi.h>
+
+#include <deal.II/distributed/tria_base.h>
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/fe/mapping_q1.h>
 #include <deal.II/numerics/vector_tools.h>
@@ -305,6 +308,45 @@ namespace knee_contact
         constraints.merge(
           sliding_constraints,
           AffineConstraints<double>::MergeConflictBehavior::left_object_wins);
+      }
+    // A whole mesh (a serial Triangulation, MPI perhaps not initialised)
+    // has every line already.
+    if (dynamic_cast<const dealii::parallel::TriangulationBase<dim> *>(
+          &dof_handler.get_triangulation()) != nullptr)
+      {
+        const MPI_Comm comm =
+          dof_handler.get_triangulation().get_communicator();
+        // The lines of this rank's dofs, flattened to doubles (indices are
+        // below 2^53) for one all-gather: index, inhomogeneity, entries.
+        const IndexSet     &owned = dof_handler.locally_owned_dofs();
+        std::vector<double> mine;
+        for (const auto &line : constraints.get_lines())
+          if (owned.is_element(line.index))
+            {
+              mine.push_back(line.index);
+              mine.push_back(line.inhomogeneity);
+              mine.push_back(line.entries.size());
+              for (const auto &[j, c] : line.entries)
+                {
+                  mine.push_back(j);
+                  mine.push_back(c);
+                }
+            }
+        constraints.clear();
+        for (const auto &theirs : Utilities::MPI::all_gather(comm, mine))
+          for (std::size_t at = 0; at < theirs.size();)
+            {
+              const auto i = static_cast<types::global_dof_index>(theirs[at]);
+              constraints.add_line(i);
+              constraints.set_inhomogeneity(i, theirs[at + 1]);
+              const std::size_t n = theirs[at + 2];
+              at += 3;
+              for (std::size_t k = 0; k < n; ++k, at += 2)
+                constraints.add_entry(i,
+                                      static_cast<types::global_dof_index>(
+                                        theirs[at]),
+                                      theirs[at + 1]);
+            }
       }
     constraints.close();
   }

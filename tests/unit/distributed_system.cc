@@ -10,14 +10,20 @@
 //   dofs sit at the vertices), gives C x on both. Asserted, to 1e-12
 //   relative to the largest entry (a sum of the same cell matrices in
 //   another order): every owned row of C x, and the energy x^T C x;
+// - BoundaryConditions::make_constraints() makes the Gamma_u and Gamma_o
+//   lines of each rank's dofs and gathers them: on every rank the same
+//   constrained dofs as the whole mesh's (carried back), the same entries
+//   and inhomogeneities to 1e-12 relative to the line's largest (the
+//   normals of sliding faces summed in another order);
 // - ContactInterfaces::make_pairs() collects the sides from the faces of
 //   the cells each rank owns and gathers them (keyed by the whole mesh's
-//   vertex indices), with the scene's Gamma_u and Gamma_o lines carried to
-//   the new numbering. Asserted on every rank: the same rows in the same
+//   vertex indices), with those lines. Asserted on every rank: the same
+//   rows in the same
 //   order, each row's slave position, gap, weight, entries (dofs carried
 //   back) and the same after the lines' substitution, to 1e-12 relative to
 //   the row's largest, and the same eliminated dof.
-// Scenes: 3D tetrahedra (the contact patch: mortar), 3D hexahedra (the QP
+// Scenes: 3D tetrahedra (the contact patch: mortar; and rotated, its
+// sliding bottom a slanted plane), 3D hexahedra (the QP
 // scene: mortar, non-matching) and 2D quadrilaterals (the QP scene:
 // node-to-segment), two bodies each. Printed by rank 0, the same for any
 // number of ranks.
@@ -158,15 +164,32 @@ namespace
           here_of[w]  = i;
         }
     AffineConstraints<double> lines;
-    for (const auto &line : problem.base_constraints().get_lines())
+    problem.boundary_conditions_of().make_constraints(dofs, lines);
+    const AffineConstraints<double> &whole_lines = problem.base_constraints();
+    bool lines_agree = lines.n_constraints() == whole_lines.n_constraints();
+    for (const auto &line : whole_lines.get_lines())
       {
         const auto i = here_of.at(line.index);
-        lines.add_line(i);
+        if (!lines.is_constrained(i))
+          {
+            lines_agree = false;
+            continue;
+          }
+        const auto &here_entries = *lines.get_constraint_entries(i);
+        std::map<types::global_dof_index, double> here;
+        for (const auto &[j, c] : here_entries)
+          here[whole_of.at(j)] = c;
+        double scale = std::max(1., std::abs(line.inhomogeneity));
         for (const auto &[j, c] : line.entries)
-          lines.add_entry(i, here_of.at(j), c);
-        lines.set_inhomogeneity(i, line.inhomogeneity);
+          scale = std::max(scale, std::abs(c));
+        lines_agree &= here.size() == line.entries.size() &&
+                       std::abs(lines.get_inhomogeneity(i) -
+                                line.inhomogeneity) <= 1e-12 * scale;
+        for (const auto &[j, c] : line.entries)
+          lines_agree &=
+            here.count(j) == 1 && std::abs(here[j] - c) <= 1e-12 * scale;
       }
-    lines.close();
+    lines_agree = Utilities::MPI::min(int(lines_agree), comm) == 1;
     const ContactPairs<dim> pairs =
       problem.contact_interfaces_of().make_pairs(dofs, lines, &mesh.vertex_id);
     const ContactPairs<dim> &reference = problem.pairs();
@@ -221,7 +244,10 @@ namespace
                 << (std::abs(energy - x_C_x) <= 1e-12 * std::abs(x_C_x)
                       ? "equal"
                       : "DIFFERENT")
-                << " to 1e-12\n  contact rows (" << reference.size()
+                << " to 1e-12\n  Gamma_u and Gamma_o lines ("
+                << whole_lines.n_constraints() << ") on the distributed mesh: "
+                << (lines_agree ? "those of the whole mesh" : "DIFFERENT")
+                << "\n  contact rows (" << reference.size()
                 << ") on the distributed mesh: "
                 << (rows_agree ? "those of the whole mesh" : "DIFFERENT")
                 << std::endl;
@@ -233,6 +259,7 @@ main(int argc, char **argv)
 {
   Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
   check<3>("../scenes/contact_patch_3d_tet.prm");
+  check<3>("../scenes/contact_patch_3d_tet_rotated.prm");
   check<3>("qp_scene_3d.prm");
   check<2>("qp_scene.prm");
 }

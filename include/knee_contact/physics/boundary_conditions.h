@@ -81,6 +81,10 @@ namespace knee_contact
      * Gamma_o uses deal.II's no-normal-flux constraints, which rotate the
      * constraint to the averaged vertex normal on slanted and curved
      * boundaries. Where a vertex lies on Gamma_u and Gamma_o, Gamma_u wins.
+     * On a distributed mesh (DistributedMesh) each rank makes the lines of
+     * the dofs it owns (its cells and their ghosts hold every face at
+     * them) and every rank gathers them all: the lines of a surface's
+     * dofs, the same on every rank.
      */
     void
     make_constraints(const DoFHandler<dim>     &dof_handler,
