@@ -281,13 +281,12 @@ namespace knee_contact
       return true;
     }
 
-    // Faces that are neither segments, triangles nor quadrilaterals cannot
-    // occur in deal.II's meshes; 3D faces carry 3 or 4 vertices.
     /**
      * A distributed mesh's sides: every rank's faces (those of the cells
      * it owns) on every rank, rank by rank, and the slave vertices' sums
      * (normal, weight) over the ranks' faces. Flattened to doubles for
-     * one all-gather (indices, keys and counts are below 2^53).
+     * one deal.II all-gather (indices, keys and counts are below 2^53);
+     * written here because the sides are this program's own structure.
      */
     template <int dim>
     void
@@ -378,6 +377,8 @@ namespace knee_contact
       sides = std::move(all);
     }
 
+    // Faces that are neither segments, triangles nor quadrilaterals cannot
+    // occur in deal.II's meshes; 3D faces carry 3 or 4 vertices.
     template <int dim>
     ContactSides<dim>
     collect_sides(const DoFHandler<dim>           &dof_handler,
@@ -406,7 +407,13 @@ namespace knee_contact
                   side.vertex_keys[v] = vertex_id != nullptr
                                           ? vertex_id->at(face->vertex_index(v))
                                           : face->vertex_index(v);
-                  side.vertices[v]    = face->vertex(v);
+                  AssertThrow(side.vertex_keys[v] !=
+                                numbers::invalid_unsigned_int,
+                              ExcMessage("Contact: a vertex of a refined "
+                                         "distributed mesh has no whole "
+                                         "index (distribute the mesh made "
+                                         "whole at its refinement)"));
+                  side.vertices[v] = face->vertex(v);
                   for (unsigned int d = 0; d < dim; ++d)
                     side.dofs[v][d] = face->vertex_dof_index(v, d);
                 }

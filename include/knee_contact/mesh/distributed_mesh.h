@@ -13,13 +13,13 @@ namespace knee_contact
   /**
    * A mesh divided over the ranks of a parallel run (issue 38's distributed
    * stage): each rank holds its cells (a METIS partition of the cells) and
-   * the layer of ghost cells that share a vertex with them, in deal.II's
+   * a layer of ghost cells around them, in deal.II's
    * parallel::fullydistributed::Triangulation, which takes simplices and
    * hexahedra alike (p4est's takes hexahedra only) and cannot be refined:
    * a refined mesh is made whole and distributed again, as the
    * tetrahedral refinement's remeshing already does. Measured at 1e6 DoFs
-   * (doc/parallel.md, "The distributed mesh"): 259 MB of triangulation and
-   * 73 MB of DoFs a rank on two ranks, against 484 and 144 whole.
+   * (doc/parallel.md, "The distributed mesh (begun)"): 259 MB of triangulation
+   * and 73 MB of DoFs a rank on two ranks, against 484 and 144 whole.
    */
   template <int dim>
   struct DistributedMesh
