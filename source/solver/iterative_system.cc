@@ -1,3 +1,4 @@
+#include <knee_contact/base/interruption.h>
 #include <knee_contact/base/parallel.h>
 #include <knee_contact/solver/active_set.h>
 #include <knee_contact/solver/contact_system.h>
@@ -23,7 +24,10 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstdlib>
+#include <iostream>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -281,6 +285,52 @@ namespace knee_contact
 
 
 
+  namespace
+  {
+    /**
+     * Trilinos ML ends the process by exit(1) when an allocation in its
+     * hierarchy's set-up fails (its pr_error: "Not enough space to get a
+     * matrix row", seen under an address-space limit in
+     * hardening/memory_limit, where a run must end in the program's one
+     * out-of-memory line): while a guard lives, an exit handler says so in
+     * that line and leaves as main()'s out_of_memory() does (its temporary
+     * files removed, exit code 1, ExitCode::input_error). Not a library's
+     * job: ML offers no hook for it.
+     */
+    class MLExitGuard
+    {
+    public:
+      MLExitGuard()
+      {
+        static const bool registered = std::atexit(&said_on_exit) == 0;
+        (void)registered;
+        active = true;
+      }
+      ~MLExitGuard()
+      {
+        active = false;
+      }
+
+    private:
+      static inline std::atomic<bool> active{false};
+
+      static void
+      said_on_exit()
+      {
+        if (!active)
+          return;
+        std::cerr << "knee_contact: error: out of memory: Trilinos ML ended "
+                     "the run while it built the AMG hierarchy (an allocation "
+                     "failed)"
+                  << std::endl;
+        interruption::remove_registered();
+        std::_Exit(1);
+      }
+    };
+  } // namespace
+
+
+
   class IterativeContactSystem::Implementation
   {
   public:
@@ -486,7 +536,8 @@ namespace knee_contact
   void
   IterativeContactSystem::Implementation::build_amg(const bool anew)
   {
-    Timer clock;
+    const MLExitGuard guard;
+    Timer             clock;
     // Another set's hierarchy is recomputed on its aggregates (ML's
     // ReComputePreconditioner: the same aggregates and null space, the new
     // matrix's Galerkin products and smoothers; the matrix is refilled in
