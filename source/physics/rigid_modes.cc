@@ -1,10 +1,12 @@
 #include <knee_contact/physics/rigid_modes.h>
 
+#include <deal.II/base/mpi.h>
 #include <deal.II/base/tensor.h>
 
 #include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/lapack_full_matrix.h>
 
+#include <deal.II/distributed/tria_base.h>
 #include <deal.II/fe/fe.h>
 
 #include <cmath>
@@ -39,26 +41,62 @@ namespace knee_contact
     std::vector<Point<dim>> lower(names.size(), huge),
       upper(names.size(), -huge);
     for (const auto &cell : dof_handler.active_cell_iterators())
+      if (!cell->is_artificial())
+        {
+          const unsigned int body = body_of_cell[cell->active_cell_index()];
+          for (const unsigned int v : cell->vertex_indices())
+            {
+              const Point<dim> &x = cell->vertex(v);
+              for (unsigned int c = 0; c < fe.n_dofs_per_vertex(); ++c)
+                {
+                  const types::global_dof_index dof =
+                    cell->vertex_dof_index(v, c);
+                  dof_position[dof] = x;
+                  dof_body[dof]     = body;
+                  // FESystem numbers a vertex's dofs by component.
+                  dof_component[dof] = c;
+                }
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  lower[body][d] = std::min(lower[body][d], x[d]);
+                  upper[body][d] = std::max(upper[body][d], x[d]);
+                }
+            }
+        }
+    // A distributed mesh: every rank takes every dof's data from its
+    // owner (whole vectors, as the loop's: the rows' dofs are anywhere),
+    // packed as doubles for one all-gather (indices below 2^53), and the
+    // bodies' boxes over the ranks.
+    const auto *distributed =
+      dynamic_cast<const dealii::parallel::TriangulationBase<dim> *>(
+        &dof_handler.get_triangulation());
+    if (distributed != nullptr)
       {
-        const unsigned int body = body_of_cell[cell->active_cell_index()];
-        for (const unsigned int v : cell->vertex_indices())
+        const MPI_Comm      comm = distributed->get_communicator();
+        std::vector<double> mine;
+        for (const auto dof : dof_handler.locally_owned_dofs())
           {
-            const Point<dim> &x = cell->vertex(v);
-            for (unsigned int c = 0; c < fe.n_dofs_per_vertex(); ++c)
-              {
-                const types::global_dof_index dof =
-                  cell->vertex_dof_index(v, c);
-                dof_position[dof] = x;
-                dof_body[dof]     = body;
-                // FESystem numbers a vertex's dofs by component.
-                dof_component[dof] = c;
-              }
+            mine.push_back(dof);
+            mine.push_back(dof_body[dof]);
+            mine.push_back(dof_component[dof]);
             for (unsigned int d = 0; d < dim; ++d)
-              {
-                lower[body][d] = std::min(lower[body][d], x[d]);
-                upper[body][d] = std::max(upper[body][d], x[d]);
-              }
+              mine.push_back(dof_position[dof][d]);
           }
+        for (const auto &theirs : Utilities::MPI::all_gather(comm, mine))
+          for (std::size_t k = 0; k < theirs.size(); k += 3 + dim)
+            {
+              const auto dof     = types::global_dof_index(theirs[k]);
+              dof_body[dof]      = theirs[k + 1];
+              dof_component[dof] = theirs[k + 2];
+              for (unsigned int d = 0; d < dim; ++d)
+                dof_position[dof][d] = theirs[k + 3 + d];
+            }
+        for (unsigned int b = 0; b < names.size(); ++b)
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              lower[b][d] = Utilities::MPI::min(lower[b][d], comm);
+              upper[b][d] = Utilities::MPI::max(upper[b][d], comm);
+            }
       }
     for (unsigned int b = 0; b < names.size(); ++b)
       {

@@ -1,16 +1,19 @@
 #include <knee_contact/physics/elements.h>
 #include <knee_contact/postprocess/results.h>
 
+#include <deal.II/base/mpi.h>
 #include <deal.II/base/quadrature_lib.h>
 
 #include <deal.II/lac/affine_constraints.h>
 
+#include <deal.II/distributed/tria_base.h>
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/fe/fe_values.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <set>
 
 namespace knee_contact
 {
@@ -29,8 +32,17 @@ namespace knee_contact
                  pairs,
                  contact] = state;
     Results<dim> results;
-    results.n_dofs   = dof_handler.n_dofs();
-    results.n_cells  = dof_handler.get_triangulation().n_active_cells();
+    results.n_dofs = dof_handler.n_dofs();
+    // On a distributed mesh (DistributedMesh) each rank visits the cells
+    // it owns (the sums below over the dofs it owns, a vertex's dofs all
+    // one rank's) and the ranks sum and take the extremes; the vectors
+    // (C x, d, x) and the contact rows are every rank's, whole. A whole
+    // mesh's cells and dofs are all owned: no reduction.
+    const auto *distributed =
+      dynamic_cast<const dealii::parallel::TriangulationBase<dim> *>(
+        &dof_handler.get_triangulation());
+    const IndexSet owned = dof_handler.locally_owned_dofs();
+    results.n_cells  = dof_handler.get_triangulation().n_global_active_cells();
     results.elements = elements::name(dof_handler.get_fe().reference_cell());
     results.n_bodies =
       body_of_cell.empty()
@@ -76,14 +88,15 @@ namespace knee_contact
     // Applied load and reactions by vertex, each vertex once.
     std::vector<bool> counted(dof_handler.n_dofs(), false);
     for (const auto &cell : dof_handler.active_cell_iterators())
-      for (const unsigned int v : cell->vertex_indices())
-        for (unsigned int d = 0; d < dim; ++d)
-          {
-            const auto dof = cell->vertex_dof_index(v, d);
-            if (!counted[dof])
-              results.applied_load[d] += rhs(dof);
-            counted[dof] = true;
-          }
+      if (cell->is_locally_owned())
+        for (const unsigned int v : cell->vertex_indices())
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              const auto dof = cell->vertex_dof_index(v, d);
+              if (!counted[dof] && owned.is_element(dof))
+                results.applied_load[d] += rhs(dof);
+              counted[dof] = true;
+            }
     // Each component goes to the condition that holds it: a displacement
     // condition for its prescribed components first, then sliding.
     std::fill(counted.begin(), counted.end(), false);
@@ -92,20 +105,43 @@ namespace knee_contact
         if (condition.type ==
             (sliding ? BoundaryType::sliding : BoundaryType::displacement))
           for (const auto &cell : dof_handler.active_cell_iterators())
-            for (const auto &face : cell->face_iterators())
-              if (face->at_boundary() &&
-                  condition.ids.count(face->boundary_id()))
-                for (const unsigned int v : face->vertex_indices())
-                  for (unsigned int d = 0; d < dim; ++d)
-                    {
-                      const auto dof = face->vertex_dof_index(v, d);
-                      if (!counted[dof] && (sliding || condition.mask[d]))
-                        {
-                          results.reactions[face->boundary_id()][d] +=
-                            support_force(dof);
-                          counted[dof] = true;
-                        }
-                    }
+            if (!cell->is_artificial())
+              for (const auto &face : cell->face_iterators())
+                if (face->at_boundary() &&
+                    condition.ids.count(face->boundary_id()))
+                  for (const unsigned int v : face->vertex_indices())
+                    for (unsigned int d = 0; d < dim; ++d)
+                      {
+                        const auto dof = face->vertex_dof_index(v, d);
+                        if (!counted[dof] && owned.is_element(dof) &&
+                            (sliding || condition.mask[d]))
+                          {
+                            results.reactions[face->boundary_id()][d] +=
+                              support_force(dof);
+                            counted[dof] = true;
+                          }
+                      }
+    if (distributed != nullptr)
+      {
+        // The load and each boundary id's reaction summed over the ranks
+        // (an id's faces can lie on some ranks only: every id of a
+        // condition is summed, those no rank has left out).
+        const MPI_Comm comm  = distributed->get_communicator();
+        results.applied_load = Utilities::MPI::sum(results.applied_load, comm);
+        std::map<types::boundary_id, Tensor<1, dim>> reactions;
+        for (const auto &condition : boundary_conditions.conditions())
+          for (const types::boundary_id id : condition.ids)
+            {
+              const auto found = results.reactions.find(id);
+              const bool here  = found != results.reactions.end();
+              const auto sum =
+                Utilities::MPI::sum(here ? found->second : Tensor<1, dim>(),
+                                    comm);
+              if (Utilities::MPI::max(int(here), comm) == 1)
+                reactions[id] = sum;
+            }
+        results.reactions = std::move(reactions);
+      }
     // The force scale: the load, the reactions, or for a scene driven by
     // prescribed displacements the force E max|u| that straining a body of
     // unit size by max|u| takes.
@@ -132,36 +168,65 @@ namespace knee_contact
     std::vector<SymmetricTensor<2, dim>> strains(n_vertices);
     const FEValuesExtractors::Vector     displacement(0);
     results.n_cell_vertices = n_vertices;
-    results.vertex_stress_yy.resize(std::size_t(results.n_cells) * n_vertices);
-    results.vertex_von_mises.resize(std::size_t(results.n_cells) * n_vertices);
+    // (By this rank's active cell index: a distributed mesh's cells here.)
+    const std::size_t n_here = dof_handler.get_triangulation().n_active_cells();
+    results.vertex_stress_yy.resize(n_here * n_vertices);
+    results.vertex_von_mises.resize(n_here * n_vertices);
     for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          fe_values.reinit(cell);
+          fe_values[displacement].get_function_symmetric_gradients(solution,
+                                                                   strains);
+          const Material<dim> &material = materials[cell->material_id()];
+          auto                 range    = results.stress_yy_range.emplace(
+            cell->material_id(),
+            std::make_pair(std::numeric_limits<double>::max(),
+                           -std::numeric_limits<double>::max()));
+          double &von_mises_max = results.von_mises_max[cell->material_id()];
+          for (unsigned int v = 0; v < n_vertices; ++v)
+            {
+              const SymmetricTensor<2, dim> stress =
+                material.stress(strains[v]);
+              const double      syy = stress[1][1];
+              const std::size_t entry =
+                results.vertex_entry(cell->active_cell_index(), v);
+              results.vertex_stress_yy[entry] = syy;
+              const double von_mises          = material.von_mises(stress);
+              results.vertex_von_mises[entry] = von_mises;
+              von_mises_max = std::max(von_mises_max, von_mises);
+              range.first->second.first =
+                std::min(range.first->second.first, syy);
+              range.first->second.second =
+                std::max(range.first->second.second, syy);
+            }
+        }
+
+    if (distributed != nullptr)
       {
-        fe_values.reinit(cell);
-        fe_values[displacement].get_function_symmetric_gradients(solution,
-                                                                 strains);
-        const Material<dim> &material = materials[cell->material_id()];
-        auto                 range    = results.stress_yy_range.emplace(
-          cell->material_id(),
-          std::make_pair(std::numeric_limits<double>::max(),
-                         -std::numeric_limits<double>::max()));
-        double &von_mises_max = results.von_mises_max[cell->material_id()];
-        for (unsigned int v = 0; v < n_vertices; ++v)
+        // Each material's extremes over the ranks (a material can lie on
+        // some ranks only).
+        const MPI_Comm               comm = distributed->get_communicator();
+        const double                 huge = std::numeric_limits<double>::max();
+        std::set<types::material_id> ids;
+        for (const auto &[id, range] : results.stress_yy_range)
+          ids.insert(id);
+        const std::vector<unsigned int> mine(ids.begin(), ids.end());
+        for (const auto &theirs : Utilities::MPI::all_gather(comm, mine))
+          ids.insert(theirs.begin(), theirs.end());
+        for (const types::material_id id : ids)
           {
-            const SymmetricTensor<2, dim> stress = material.stress(strains[v]);
-            const double                  syy    = stress[1][1];
-            const std::size_t             entry =
-              results.vertex_entry(cell->active_cell_index(), v);
-            results.vertex_stress_yy[entry] = syy;
-            const double von_mises          = material.von_mises(stress);
-            results.vertex_von_mises[entry] = von_mises;
-            von_mises_max = std::max(von_mises_max, von_mises);
-            range.first->second.first =
-              std::min(range.first->second.first, syy);
-            range.first->second.second =
-              std::max(range.first->second.second, syy);
+            const auto found = results.stress_yy_range.find(id);
+            const bool here  = found != results.stress_yy_range.end();
+            const std::pair<double, double> range =
+              here ? found->second : std::make_pair(huge, -huge);
+            results.stress_yy_range[id] = {
+              Utilities::MPI::min(range.first, comm),
+              Utilities::MPI::max(range.second, comm)};
+            results.von_mises_max[id] =
+              Utilities::MPI::max(here ? results.von_mises_max[id] : 0., comm);
           }
       }
-
     results.interfaces.resize(interfaces.interfaces().size());
     for (unsigned int i = 0; i < results.interfaces.size(); ++i)
       {

@@ -5,6 +5,7 @@
 
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 #include <deal.II/lac/sparsity_pattern.h>
+#include <deal.II/lac/trilinos_sparsity_pattern.h>
 
 #include <deal.II/dofs/dof_tools.h>
 
@@ -174,6 +175,159 @@ namespace knee_contact
 
 
 
+  namespace
+  {
+    /**
+     * The pattern of every active set's condensed system (see the comment
+     * in the code), for both front ends of make_sparsity_pattern():
+     * @p for_each_row(f) calls f(i, columns) for the rows of the mesh's
+     * pattern to expand (all of them, or this rank's), @p add(a, columns)
+     * adds sorted columns to row a, @p adds_row(a) says whether this
+     * pattern holds row a (the springs' rows).
+     */
+    void
+    expand_pattern(
+      const types::global_dof_index n,
+      const std::function<void(
+        const std::function<void(const types::global_dof_index,
+                                 const std::vector<types::global_dof_index> &)>
+          &)>                      &for_each_row,
+      const std::function<void(const types::global_dof_index,
+                               const std::vector<types::global_dof_index> &)>
+                                                               &add,
+      const std::function<bool(const types::global_dof_index)> &adds_row,
+      const AffineConstraints<double>                          &base,
+      const std::vector<ContactRow>                            &pairs,
+      const bool                                                cycles_allowed,
+      const std::vector<std::vector<unsigned int>>             &spring_rows)
+    {
+      // One sparsity pattern serves every active set. Condensing a set of
+      // lines couples each dof i with the dofs its line refers to after
+      // chains are resolved, and which chains exist depends on the active set
+      // (a hanging node refers to a slave dof, which refers to master dofs
+      // only while its pair is active). So E(i) is the transitive closure of
+      // the one-level entries R(i) (Gamma_u/Gamma_o/hanging-node line, or the
+      // reduced row of the pair eliminating i), and an entry (i, j) of the
+      // mesh's pattern needs E(i) x E(j).
+      std::map<types::global_dof_index, std::set<types::global_dof_index>>
+        one_level;
+      for (const auto &line : base.get_lines())
+        for (const auto &entry : line.entries)
+          one_level[line.index].insert(entry.first);
+      for (const auto &pair : pairs)
+        if (pair.eliminated != numbers::invalid_dof_index)
+          for (const auto &entry : pair.reduced_row)
+            if (entry.first != pair.eliminated)
+              one_level[pair.eliminated].insert(entry.first);
+      std::map<types::global_dof_index, std::vector<types::global_dof_index>>
+                                        expansion;
+      std::set<types::global_dof_index> in_progress;
+      const std::function<const std::vector<types::global_dof_index> &(
+        types::global_dof_index)>
+        closure = [&](const types::global_dof_index i)
+        -> const std::vector<types::global_dof_index> & {
+        const auto known = expansion.find(i);
+        if (known != expansion.end())
+          return known->second;
+        // Lines that refer to each other in a cycle cannot be constraints; the
+        // elimination in make_pairs() is meant to prevent it among rows that
+        // can be active together. With friction the normal and tangential
+        // rows of a pair may refer to each other, but they are never active
+        // together (a sticking pair is held by its X and Y rows): there the
+        // closure is the set of dofs reachable from i.
+        if (!in_progress.insert(i).second)
+          {
+            if (!cycles_allowed)
+              throw std::logic_error("the contact rows eliminate dofs that "
+                                     "refer to each other in a cycle (dof " +
+                                     std::to_string(i) + ")");
+            std::set<types::global_dof_index>    reached = {i};
+            std::vector<types::global_dof_index> stack   = {i};
+            while (!stack.empty())
+              {
+                const auto k = stack.back();
+                stack.pop_back();
+                const auto it = one_level.find(k);
+                if (it != one_level.end())
+                  for (const auto e : it->second)
+                    if (reached.insert(e).second)
+                      stack.push_back(e);
+              }
+            return expansion[i] =
+                     std::vector<types::global_dof_index>(reached.begin(),
+                                                          reached.end());
+          }
+        std::set<types::global_dof_index> dofs = {i};
+        const auto                        it   = one_level.find(i);
+        if (it != one_level.end())
+          for (const auto e : it->second)
+            {
+              const auto &sub = closure(e);
+              dofs.insert(sub.begin(), sub.end());
+            }
+        return expansion[i] =
+                 std::vector<types::global_dof_index>(dofs.begin(), dofs.end());
+      };
+      for (const auto &entry : one_level)
+        closure(entry.first);
+
+      // Each dof's expansion, by index (a map lookup per entry of the mesh's
+      // pattern took 8.3 s at 1e6 dofs); none: the dof itself.
+      std::vector<const std::vector<types::global_dof_index> *> expansion_of(
+        n, nullptr);
+      for (const auto &[i, e] : expansion)
+        expansion_of[i] = &e;
+
+      // A spring k w w^T couples every dof of its rows' reduced rows with
+      // every other, and each of them expands as a line of the mesh's
+      // pattern does.
+      for (const auto &group : spring_rows)
+        {
+          std::set<types::global_dof_index> dofs;
+          for (const unsigned int r : group)
+            for (const auto &entry : pairs[r].reduced_row)
+              if (const auto *e = expansion_of[entry.first])
+                dofs.insert(e->begin(), e->end());
+              else
+                dofs.insert(entry.first);
+          const std::vector<types::global_dof_index> sorted(dofs.begin(),
+                                                            dofs.end());
+          for (const auto a : sorted)
+            if (adds_row(a))
+              add(a, sorted);
+        }
+      // Row by row, each row's columns expanded, sorted and added at once.
+      std::vector<types::global_dof_index> expanded;
+      for_each_row([&](const types::global_dof_index               i,
+                       const std::vector<types::global_dof_index> &columns) {
+        expanded.clear();
+        bool expanded_columns = false;
+        for (const auto j : columns)
+          if (const auto *ej = expansion_of[j])
+            {
+              expanded.insert(expanded.end(), ej->begin(), ej->end());
+              expanded_columns = true;
+            }
+          else
+            expanded.push_back(j);
+        if (expanded_columns ||
+            !std::is_sorted(expanded.begin(), expanded.end()))
+          {
+            std::sort(expanded.begin(), expanded.end());
+            expanded.erase(std::unique(expanded.begin(), expanded.end()),
+                           expanded.end());
+          }
+        if (const auto *ei = expansion_of[i])
+          for (const auto a : *ei)
+            add(a, expanded);
+        else
+          add(i, expanded);
+      });
+    }
+  } // namespace
+
+
+
   void
   ActiveSetSolver::make_sparsity_pattern(
     const DynamicSparsityPattern                 &mesh_pattern,
@@ -183,128 +337,74 @@ namespace knee_contact
     const bool                                    cycles_allowed,
     const std::vector<std::vector<unsigned int>> &spring_rows)
   {
-    // One sparsity pattern serves every active set. Condensing a set of
-    // lines couples each dof i with the dofs its line refers to after
-    // chains are resolved, and which chains exist depends on the active set
-    // (a hanging node refers to a slave dof, which refers to master dofs
-    // only while its pair is active). So E(i) is the transitive closure of
-    // the one-level entries R(i) (Gamma_u/Gamma_o/hanging-node line, or the
-    // reduced row of the pair eliminating i), and an entry (i, j) of the
-    // mesh's pattern needs E(i) x E(j).
-    std::map<types::global_dof_index, std::set<types::global_dof_index>>
-      one_level;
-    for (const auto &line : base.get_lines())
-      for (const auto &entry : line.entries)
-        one_level[line.index].insert(entry.first);
-    for (const auto &pair : pairs)
-      if (pair.eliminated != numbers::invalid_dof_index)
-        for (const auto &entry : pair.reduced_row)
-          if (entry.first != pair.eliminated)
-            one_level[pair.eliminated].insert(entry.first);
-    std::map<types::global_dof_index, std::vector<types::global_dof_index>>
-                                      expansion;
-    std::set<types::global_dof_index> in_progress;
-    const std::function<const std::vector<types::global_dof_index> &(
-      types::global_dof_index)>
-      closure = [&](const types::global_dof_index i)
-      -> const std::vector<types::global_dof_index> & {
-      const auto known = expansion.find(i);
-      if (known != expansion.end())
-        return known->second;
-      // Lines that refer to each other in a cycle cannot be constraints; the
-      // elimination in make_pairs() is meant to prevent it among rows that
-      // can be active together. With friction the normal and tangential
-      // rows of a pair may refer to each other, but they are never active
-      // together (a sticking pair is held by its X and Y rows): there the
-      // closure is the set of dofs reachable from i.
-      if (!in_progress.insert(i).second)
-        {
-          if (!cycles_allowed)
-            throw std::logic_error("the contact rows eliminate dofs that "
-                                   "refer to each other in a cycle (dof " +
-                                   std::to_string(i) + ")");
-          std::set<types::global_dof_index>    reached = {i};
-          std::vector<types::global_dof_index> stack   = {i};
-          while (!stack.empty())
-            {
-              const auto k = stack.back();
-              stack.pop_back();
-              const auto it = one_level.find(k);
-              if (it != one_level.end())
-                for (const auto e : it->second)
-                  if (reached.insert(e).second)
-                    stack.push_back(e);
-            }
-          return expansion[i] =
-                   std::vector<types::global_dof_index>(reached.begin(),
-                                                        reached.end());
-        }
-      std::set<types::global_dof_index> dofs = {i};
-      const auto                        it   = one_level.find(i);
-      if (it != one_level.end())
-        for (const auto e : it->second)
-          {
-            const auto &sub = closure(e);
-            dofs.insert(sub.begin(), sub.end());
-          }
-      return expansion[i] =
-               std::vector<types::global_dof_index>(dofs.begin(), dofs.end());
-    };
-    for (const auto &entry : one_level)
-      closure(entry.first);
-
-    // Each dof's expansion, by index (a map lookup per entry of the mesh's
-    // pattern took 8.3 s at 1e6 dofs); none: the dof itself.
-    std::vector<const std::vector<types::global_dof_index> *> expansion_of(
-      mesh_pattern.n_rows(), nullptr);
-    for (const auto &[i, e] : expansion)
-      expansion_of[i] = &e;
-
-    DynamicSparsityPattern dsp(mesh_pattern.n_rows());
-    // A spring k w w^T couples every dof of its rows' reduced rows with
-    // every other, and each of them expands as a line of the mesh's
-    // pattern does.
-    for (const auto &group : spring_rows)
-      {
-        std::set<types::global_dof_index> dofs;
-        for (const unsigned int r : group)
-          for (const auto &entry : pairs[r].reduced_row)
-            if (const auto *e = expansion_of[entry.first])
-              dofs.insert(e->begin(), e->end());
-            else
-              dofs.insert(entry.first);
-        const std::vector<types::global_dof_index> sorted(dofs.begin(),
-                                                          dofs.end());
-        for (const auto a : sorted)
-          dsp.add_entries(a, sorted.begin(), sorted.end(), true);
-      }
-    // Row by row, each row's columns expanded, sorted and added at once.
+    DynamicSparsityPattern               dsp(mesh_pattern.n_rows());
     std::vector<types::global_dof_index> columns;
-    for (types::global_dof_index i = 0; i < mesh_pattern.n_rows(); ++i)
-      {
-        columns.clear();
-        bool expanded_columns = false;
-        for (auto it = mesh_pattern.begin(i); it != mesh_pattern.end(i); ++it)
-          if (const auto *ej = expansion_of[it->column()])
-            {
-              columns.insert(columns.end(), ej->begin(), ej->end());
-              expanded_columns = true;
-            }
-          else
-            columns.push_back(it->column());
-        if (expanded_columns)
+    expand_pattern(
+      mesh_pattern.n_rows(),
+      [&](const auto &f) {
+        for (types::global_dof_index i = 0; i < mesh_pattern.n_rows(); ++i)
           {
-            std::sort(columns.begin(), columns.end());
-            columns.erase(std::unique(columns.begin(), columns.end()),
-                          columns.end());
+            columns.clear();
+            for (auto it = mesh_pattern.begin(i); it != mesh_pattern.end(i);
+                 ++it)
+              columns.push_back(it->column());
+            f(i, columns);
           }
-        if (const auto *ei = expansion_of[i])
-          for (const auto a : *ei)
-            dsp.add_entries(a, columns.begin(), columns.end(), true);
-        else
-          dsp.add_entries(i, columns.begin(), columns.end(), true);
-      }
+      },
+      [&](const types::global_dof_index               a,
+          const std::vector<types::global_dof_index> &sorted) {
+        dsp.add_entries(a, sorted.begin(), sorted.end(), true);
+      },
+      [](const types::global_dof_index) { return true; },
+      base,
+      pairs,
+      cycles_allowed,
+      spring_rows);
     sparsity_pattern.copy_from(dsp);
+  }
+
+
+
+  void
+  ActiveSetSolver::make_sparsity_pattern(
+    const TrilinosWrappers::SparsityPattern      &mesh_pattern,
+    const AffineConstraints<double>              &base,
+    const std::vector<ContactRow>                &pairs,
+    TrilinosWrappers::SparsityPattern            &sparsity_pattern,
+    const bool                                    cycles_allowed,
+    const std::vector<std::vector<unsigned int>> &spring_rows)
+  {
+    // Each rank expands its rows of the mesh's pattern; a row of another
+    // rank's a line's expansion reaches is sent to it by compress()
+    // (Epetra's FE graph keeps rows it does not own until then).
+    const IndexSet owned = mesh_pattern.locally_owned_range_indices();
+    sparsity_pattern.reinit(owned, owned, mesh_pattern.get_mpi_communicator());
+    const Epetra_CrsGraph &graph = mesh_pattern.trilinos_sparsity_pattern();
+    std::vector<types::global_dof_index> columns;
+    expand_pattern(
+      owned.size(),
+      [&](const auto &f) {
+        for (int local = 0; local < graph.NumMyRows(); ++local)
+          {
+            int  length  = 0;
+            int *indices = nullptr;
+            graph.ExtractMyRowView(local, length, indices);
+            columns.clear();
+            for (int k = 0; k < length; ++k)
+              columns.push_back(graph.ColMap().GID(indices[k]));
+            f(graph.RowMap().GID(local), columns);
+          }
+      },
+      [&](const types::global_dof_index               a,
+          const std::vector<types::global_dof_index> &sorted) {
+        sparsity_pattern.add_entries(a, sorted.begin(), sorted.end(), true);
+      },
+      [&](const types::global_dof_index a) { return owned.is_element(a); },
+      base,
+      pairs,
+      cycles_allowed,
+      spring_rows);
+    sparsity_pattern.compress();
   }
 
 

@@ -334,23 +334,30 @@ namespace knee_contact
   class IterativeContactSystem::Implementation
   {
   public:
-    Implementation(const SparsityPattern             &pattern,
-                   const SparseMatrix<double>        *matrix,
-                   const RowAssembly                 *assemble_rows,
-                   const AffineConstraints<double>   &base,
-                   const std::vector<ContactRow>     &pairs,
-                   const std::vector<Vector<double>> &modes,
-                   const unsigned int                 components,
-                   const KrylovSettings              &settings)
+    Implementation(const SparsityPattern                   *pattern,
+                   const TrilinosWrappers::SparsityPattern *distributed_pattern,
+                   const SparseMatrix<double>              *matrix,
+                   const RowAssembly                       *assemble_rows,
+                   const AffineConstraints<double>         &base,
+                   const std::vector<ContactRow>           &pairs,
+                   const std::vector<Vector<double>>       &modes,
+                   const unsigned int                       components,
+                   const KrylovSettings                    &settings)
       : matrix(matrix)
       , pattern(pattern)
-      , n(pattern.n_rows())
+      , distributed_pattern(distributed_pattern)
+      , n(pattern != nullptr ? pattern->n_rows()
+                             : distributed_pattern->n_rows())
       , base(base)
       , pairs(pairs)
       , components(components)
       , settings(settings)
-      , x(pattern.n_rows())
+      , x(n)
     {
+      AssertThrow((pattern == nullptr) != (distributed_pattern == nullptr) &&
+                    (matrix == nullptr) != (assemble_rows == nullptr) &&
+                    (distributed_pattern == nullptr || matrix == nullptr),
+                  ExcInternalError());
       // This rank's rows: whole vertices (the aggregation's blocks), a
       // METIS partition of the vertex graph made on rank 0 (a contiguous
       // block of gmsh's cell-by-cell numbering scattered over the bodies:
@@ -362,7 +369,11 @@ namespace knee_contact
       const unsigned int ranks = parallel::n_ranks(), rank = parallel::rank();
       Timer              clock;
       owned.set_size(n);
-      if (ranks == 1 || n % components != 0)
+      if (distributed_pattern != nullptr)
+        // A distributed mesh: the DoF handler's rows (whole vertices, those
+        // of the cells the rank owns).
+        owned = distributed_pattern->locally_owned_range_indices();
+      else if (ranks == 1 || n % components != 0)
         owned.add_range(n * rank / ranks,
                         rank + 1 == ranks ? n : n * (rank + 1) / ranks);
       else
@@ -373,7 +384,7 @@ namespace knee_contact
             {
               DynamicSparsityPattern graph(n_blocks, n_blocks);
               for (types::global_dof_index i = 0; i < n; i += components)
-                for (auto entry = pattern.begin(i); entry != pattern.end(i);
+                for (auto entry = pattern->begin(i); entry != pattern->end(i);
                      ++entry)
                   graph.add(i / components, entry->column() / components);
               SparsityPattern blocks;
@@ -394,24 +405,24 @@ namespace knee_contact
       for (unsigned int k = 0; k < modes.size(); ++k)
         std::copy(modes[k].begin(), modes[k].end(), null_space.begin() + k * n);
       n_modes = modes.size();
-      AssertThrow((ranks == 1) == (matrix != nullptr) &&
-                    (ranks == 1) == (assemble_rows == nullptr),
-                  ExcInternalError());
-      if (ranks > 1)
+      if (matrix == nullptr)
         assemble_rows_of_c(*assemble_rows);
     }
 
     /** C whole on one rank; none on several (rows_of_c()). */
-    const SparseMatrix<double>      *matrix;
-    const SparsityPattern           &pattern;
-    const types::global_dof_index    n;
-    const AffineConstraints<double> &base;
-    const std::vector<ContactRow>   &pairs;
-    const unsigned int               components;
-    const KrylovSettings             settings;
-    const Vector<double>            *rhs = nullptr;
-    std::vector<double>              null_space;
-    unsigned int                     n_modes = 0;
+    const SparseMatrix<double> *matrix;
+    /** Every set's condensed pattern: whole (a whole mesh), or this rank's
+     * rows of it (a distributed mesh, whose owned cells give C's rows). */
+    const SparsityPattern                   *pattern;
+    const TrilinosWrappers::SparsityPattern *distributed_pattern;
+    const types::global_dof_index            n;
+    const AffineConstraints<double>         &base;
+    const std::vector<ContactRow>           &pairs;
+    const unsigned int                       components;
+    const KrylovSettings                     settings;
+    const Vector<double>                    *rhs = nullptr;
+    std::vector<double>                      null_space;
+    unsigned int                             n_modes = 0;
 
     /** The springs of the following solves (set_springs()), as the loop
      * gave them and on the dofs. */
@@ -490,12 +501,17 @@ namespace knee_contact
     void
     assemble_rows_of_c(const RowAssembly &assemble);
 
+    /** The same on a distributed mesh: @p assemble gives the cells this
+     * rank owns; the line rows come from their owners. */
+    void
+    assemble_rows_on_distributed_mesh(const RowAssembly &assemble);
+
     /** The deal.II matrix holding C's rows of the lines (and their
-     * diagonals): C on one rank, line_rows on several. */
+     * diagonals): C whole (one rank, a whole mesh), else line_rows. */
     const SparseMatrix<double> &
     rows_of_c() const
     {
-      return parallel::n_ranks() == 1 ? *matrix : line_rows;
+      return matrix != nullptr ? *matrix : line_rows;
     }
 
     /** Calls @p f(column, value) for each entry of C's row @p row (an
@@ -733,6 +749,7 @@ namespace knee_contact
 
     if (amg_matrix.m() != n)
       amg_matrix.reinit(owned_pattern());
+    const Epetra_CrsGraph &graph = owned_pattern().trilinos_sparsity_pattern();
     std::vector<types::global_dof_index> row_columns;
     std::vector<double>                  values;
     for (const auto row : rows)
@@ -749,10 +766,13 @@ namespace knee_contact
           }
         row_columns.clear();
         values.clear();
-        for (auto entry = pattern.begin(row); entry != pattern.end(row);
-             ++entry)
+        int  length  = 0;
+        int *indices = nullptr;
+        graph.ExtractMyRowView(
+          graph.LRID(TrilinosWrappers::types::int_type(row)), length, indices);
+        for (int k = 0; k < length; ++k)
           {
-            const auto j = entry->column();
+            const types::global_dof_index j = graph.ColMap().GID(indices[k]);
             row_columns.push_back(j);
             values.push_back(constrained
                                ? (j == row ? rows_of_c().diag_element(row) : 0.)
@@ -773,7 +793,9 @@ namespace knee_contact
   const TrilinosWrappers::SparsityPattern &
   IterativeContactSystem::Implementation::owned_pattern()
   {
-    if (trilinos_pattern.n_rows() != pattern.n_rows())
+    if (distributed_pattern != nullptr)
+      return *distributed_pattern;
+    if (trilinos_pattern.n_rows() != n)
       {
         trilinos_pattern.reinit(owned, owned, parallel::communicator());
         // A row at a time (an entry at a time took 1 s at 2.3e5 dofs).
@@ -781,7 +803,7 @@ namespace knee_contact
         for (const auto row : owned)
           {
             columns.clear();
-            for (auto entry = pattern.begin(row); entry != pattern.end(row);
+            for (auto entry = pattern->begin(row); entry != pattern->end(row);
                  ++entry)
               columns.push_back(entry->column());
             trilinos_pattern.add_entries(row, columns.begin(), columns.end());
@@ -810,14 +832,19 @@ namespace knee_contact
         for (const auto &[j, a] : row.reduced_row)
           of_line[j] = true;
       }
+    if (distributed_pattern != nullptr)
+      {
+        assemble_rows_on_distributed_mesh(assemble);
+        return;
+      }
     std::vector<unsigned int> lengths(n, 1);
     for (types::global_dof_index i = 0; i < n; ++i)
       if (of_line[i])
-        lengths[i] = pattern.row_length(i);
+        lengths[i] = pattern->row_length(i);
     line_rows_pattern.reinit(n, n, lengths);
     for (types::global_dof_index i = 0; i < n; ++i)
       if (of_line[i])
-        for (auto entry = pattern.begin(i); entry != pattern.end(i); ++entry)
+        for (auto entry = pattern->begin(i); entry != pattern->end(i); ++entry)
           line_rows_pattern.add(i, entry->column());
     line_rows_pattern.compress();
     line_rows.reinit(line_rows_pattern);
@@ -855,6 +882,85 @@ namespace knee_contact
 
 
 
+  void
+  IterativeContactSystem::Implementation::assemble_rows_on_distributed_mesh(
+    const RowAssembly &assemble)
+  {
+    // Each rank adds the cells it owns (a row another rank owns is sent to
+    // it by compress(): the cells at a partition's border are made once).
+    Timer clock;
+    distributed_matrix.reinit(*distributed_pattern);
+    assemble([](const types::global_dof_index) { return true; },
+             [&](const std::vector<types::global_dof_index> &dofs,
+                 const FullMatrix<double>                   &cell_matrix) {
+               distributed_matrix.add(dofs, cell_matrix);
+             });
+    distributed_matrix.compress(VectorOperation::add);
+
+    // The rows a line can hold, from their owners to every rank (O(surface)
+    // rows; the lines and the contact rows are every rank's, and so are
+    // these rows, as on a whole mesh), packed as doubles for one all-gather
+    // (indices below 2^53): row, length, columns, values.
+    const Epetra_CrsMatrix &epetra = distributed_matrix.trilinos_matrix();
+    std::vector<double>     mine;
+    for (const auto row : owned)
+      if (of_line[row])
+        {
+          int     length  = 0;
+          double *values  = nullptr;
+          int    *columns = nullptr;
+          epetra.ExtractMyRowView(epetra.LRID(
+                                    TrilinosWrappers::types::int_type(row)),
+                                  length,
+                                  values,
+                                  columns);
+          mine.push_back(row);
+          mine.push_back(length);
+          for (int k = 0; k < length; ++k)
+            mine.push_back(epetra.ColMap().GID(columns[k]));
+          mine.insert(mine.end(), values, values + length);
+        }
+    const std::vector<std::vector<double>> all =
+      Utilities::MPI::all_gather(parallel::communicator(), mine);
+    mine = std::vector<double>();
+    std::vector<unsigned int> lengths(n, 1);
+    for (const auto &theirs : all)
+      for (std::size_t k = 0; k < theirs.size();)
+        {
+          const auto         row    = types::global_dof_index(theirs[k]);
+          const unsigned int length = theirs[k + 1];
+          lengths[row]              = std::max(1u, length);
+          k += 2 + 2 * length;
+        }
+    line_rows_pattern.reinit(n, n, lengths);
+    for (const auto &theirs : all)
+      for (std::size_t k = 0; k < theirs.size();)
+        {
+          const auto         row    = types::global_dof_index(theirs[k]);
+          const unsigned int length = theirs[k + 1];
+          for (unsigned int c = 0; c < length; ++c)
+            line_rows_pattern.add(row,
+                                  types::global_dof_index(theirs[k + 2 + c]));
+          k += 2 + 2 * length;
+        }
+    line_rows_pattern.compress();
+    line_rows.reinit(line_rows_pattern);
+    for (const auto &theirs : all)
+      for (std::size_t k = 0; k < theirs.size();)
+        {
+          const auto         row    = types::global_dof_index(theirs[k]);
+          const unsigned int length = theirs[k + 1];
+          for (unsigned int c = 0; c < length; ++c)
+            line_rows.set(row,
+                          types::global_dof_index(theirs[k + 2 + c]),
+                          theirs[k + 2 + length + c]);
+          k += 2 + 2 * length;
+        }
+    rows_assembly = clock.wall_time();
+  }
+
+
+
   template <typename Function>
   void
   IterativeContactSystem::Implementation::for_each_in_row(
@@ -862,7 +968,7 @@ namespace knee_contact
     const Function               &f) const
   {
     const SparseMatrix<double> &rows = rows_of_c();
-    if (parallel::n_ranks() == 1 || of_line[row])
+    if (matrix != nullptr || of_line[row])
       {
         for (auto entry = rows.begin(row); entry != rows.end(row); ++entry)
           f(entry->column(), entry->value());
@@ -888,7 +994,7 @@ namespace knee_contact
   IterativeContactSystem::Implementation::product(Vector<double>       &y,
                                                   const Vector<double> &x) const
   {
-    if (parallel::n_ranks() == 1)
+    if (matrix != nullptr)
       {
         matrix->vmult(y, x);
         return;
@@ -942,7 +1048,7 @@ namespace knee_contact
           std::ceil(1.5 * budget_rate * std::log10(start_residual / target) +
                     budget_extra)));
     };
-    if (parallel::n_ranks() == 1)
+    if (matrix != nullptr)
       {
         iterative::CondensedOperator operation(*matrix,
                                                constraints,
@@ -1012,7 +1118,8 @@ namespace knee_contact
     const std::vector<Vector<double>> &modes,
     const unsigned int                 components,
     const KrylovSettings              &settings)
-    : IterativeContactSystem(matrix.get_sparsity_pattern(),
+    : IterativeContactSystem(&matrix.get_sparsity_pattern(),
+                             nullptr,
                              &matrix,
                              nullptr,
                              base,
@@ -1032,7 +1139,8 @@ namespace knee_contact
     const std::vector<Vector<double>> &modes,
     const unsigned int                 components,
     const KrylovSettings              &settings)
-    : IterativeContactSystem(pattern,
+    : IterativeContactSystem(&pattern,
+                             nullptr,
                              nullptr,
                              &assemble_rows,
                              base,
@@ -1045,20 +1153,49 @@ namespace knee_contact
 
 
   IterativeContactSystem::IterativeContactSystem(
-    const SparsityPattern             &pattern,
-    const SparseMatrix<double>        *matrix,
-    const RowAssembly                 *assemble_rows,
-    const AffineConstraints<double>   &base,
-    const std::vector<ContactRow>     &pairs,
-    const std::vector<Vector<double>> &modes,
-    const unsigned int                 components,
-    const KrylovSettings              &settings)
+    const TrilinosWrappers::SparsityPattern &pattern,
+    const RowAssembly                       &assemble_cells,
+    const AffineConstraints<double>         &base,
+    const std::vector<ContactRow>           &pairs,
+    const std::vector<Vector<double>>       &modes,
+    const unsigned int                       components,
+    const KrylovSettings                    &settings)
+    : IterativeContactSystem(nullptr,
+                             &pattern,
+                             nullptr,
+                             &assemble_cells,
+                             base,
+                             pairs,
+                             modes,
+                             components,
+                             settings)
+  {}
+
+
+
+  IterativeContactSystem::IterativeContactSystem(
+    const SparsityPattern                   *pattern,
+    const TrilinosWrappers::SparsityPattern *distributed_pattern,
+    const SparseMatrix<double>              *matrix,
+    const RowAssembly                       *assemble_rows,
+    const AffineConstraints<double>         &base,
+    const std::vector<ContactRow>           &pairs,
+    const std::vector<Vector<double>>       &modes,
+    const unsigned int                       components,
+    const KrylovSettings                    &settings)
   {
     parallel::ensure_initialised();
     // (Before the implementation: on several ranks it assembles its rows.)
     const double resident = iterative::resident_MB();
-    implementation        = std::make_unique<Implementation>(
-      pattern, matrix, assemble_rows, base, pairs, modes, components, settings);
+    implementation        = std::make_unique<Implementation>(pattern,
+                                                      distributed_pattern,
+                                                      matrix,
+                                                      assemble_rows,
+                                                      base,
+                                                      pairs,
+                                                      modes,
+                                                      components,
+                                                      settings);
     implementation->resident_at_start = resident;
   }
 

@@ -118,6 +118,11 @@ namespace knee_contact
     run();
 
     // Access for unit tests.
+    Results<dim>
+    results_of_solution() const
+    {
+      return current_results();
+    }
     ActiveSetSolver &
     contact_solver()
     {

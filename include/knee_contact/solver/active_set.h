@@ -300,6 +300,21 @@ namespace knee_contact
       const std::vector<std::vector<unsigned int>> &spring_rows    = {});
 
     /**
+     * The same on a distributed mesh: each rank expands its rows of
+     * @p mesh_pattern (C's pattern, made from the cells each rank owns);
+     * @p sparsity_pattern gets this rank's rows of every set's condensed
+     * system (the lines and @p pairs are every rank's).
+     */
+    static void
+    make_sparsity_pattern(
+      const TrilinosWrappers::SparsityPattern      &mesh_pattern,
+      const AffineConstraints<double>              &base,
+      const std::vector<ContactRow>                &pairs,
+      TrilinosWrappers::SparsityPattern            &sparsity_pattern,
+      const bool                                    cycles_allowed = false,
+      const std::vector<std::vector<unsigned int>> &spring_rows    = {});
+
+    /**
      * The constraints of @p base plus the active rows of @p pairs, closed.
      */
     static void

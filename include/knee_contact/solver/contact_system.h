@@ -18,6 +18,14 @@
 #include <utility>
 #include <vector>
 
+namespace dealii
+{
+  namespace TrilinosWrappers
+  {
+    class SparsityPattern;
+  }
+} // namespace dealii
+
 namespace knee_contact
 {
   using namespace dealii;
@@ -575,6 +583,24 @@ namespace knee_contact
                            const std::vector<Vector<double>> &modes,
                            const unsigned int                 components,
                            const KrylovSettings              &settings);
+
+    /**
+     * On a distributed mesh (DistributedMesh): @p pattern holds this
+     * rank's rows of every set's condensed system
+     * (ActiveSetSolver::make_sparsity_pattern on C's pattern of the owned
+     * cells), on the DoF handler's ownership, which the path takes;
+     * @p assemble_cells gives the cells this rank owns. C's rows of the
+     * dofs a line can hold are gathered from their owners to every rank
+     * (the lines, the contact rows and the vectors the loop reads are
+     * every rank's, whole, as on a whole mesh).
+     */
+    IterativeContactSystem(const TrilinosWrappers::SparsityPattern &pattern,
+                           const RowAssembly                 &assemble_cells,
+                           const AffineConstraints<double>   &base,
+                           const std::vector<ContactRow>     &pairs,
+                           const std::vector<Vector<double>> &modes,
+                           const unsigned int                 components,
+                           const KrylovSettings              &settings);
     ~IterativeContactSystem() override;
 
     void
@@ -678,15 +704,19 @@ namespace knee_contact
     static constexpr unsigned int gmres_basis = 60;
 
   private:
-    /** Both: C whole (@p matrix) or its rows (@p assemble_rows). */
-    IterativeContactSystem(const SparsityPattern             &pattern,
-                           const SparseMatrix<double>        *matrix,
-                           const RowAssembly                 *assemble_rows,
-                           const AffineConstraints<double>   &base,
-                           const std::vector<ContactRow>     &pairs,
-                           const std::vector<Vector<double>> &modes,
-                           const unsigned int                 components,
-                           const KrylovSettings              &settings);
+    /** All three: C whole (@p matrix) or its rows (@p assemble_rows),
+     * on a whole @p pattern or on a distributed mesh's @p distributed_pattern.
+     */
+    IterativeContactSystem(
+      const SparsityPattern                   *pattern,
+      const TrilinosWrappers::SparsityPattern *distributed_pattern,
+      const SparseMatrix<double>              *matrix,
+      const RowAssembly                       *assemble_rows,
+      const AffineConstraints<double>         &base,
+      const std::vector<ContactRow>           &pairs,
+      const std::vector<Vector<double>>       &modes,
+      const unsigned int                       components,
+      const KrylovSettings                    &settings);
 
     class Implementation;
     std::unique_ptr<Implementation> implementation;
