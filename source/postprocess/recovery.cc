@@ -5,6 +5,7 @@
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/work_stream.h>
 
+#include <deal.II/distributed/tria_base.h>
 #include <deal.II/fe/fe_values.h>
 
 #include <algorithm>
@@ -97,25 +98,34 @@ namespace knee_contact
                                                        n_vertices);
     // The (vertex, material) slots and their counts from every cell, in
     // the cells' order (cheap: no strains).
+    // A distributed mesh (DistributedMesh): every rank recovers at the
+    // vertices of its cells from them and their ghosts (each such vertex's
+    // cells are all there), and no sum over the ranks is needed; a ghost's
+    // vertices that lie on artificial cells too are averaged short, but no
+    // owned cell reads them.
+    const bool distributed =
+      dynamic_cast<const dealii::parallel::TriangulationBase<dim> *>(
+        &dof_handler.get_triangulation()) != nullptr;
     for (const auto &cell : dof_handler.active_cell_iterators())
-      for (unsigned int v = 0; v < n_vertices; ++v)
-        {
-          const unsigned int vertex = cell->vertex_index(v);
-          auto              &here   = recovered[0].averages[vertex];
-          unsigned int       k      = 0;
-          while (k < here.size() && here[k].first != cell->material_id())
-            ++k;
-          if (k == here.size())
-            {
-              for (auto &r : recovered)
-                r.averages[vertex].emplace_back(cell->material_id(),
-                                                SymmetricTensor<2, dim>());
-              counts[vertex].push_back(0);
-            }
-          ++counts[vertex][k];
-          if (any_traction)
-            vertex_of_dof[cell->vertex_dof_index(v, 0)] = vertex;
-        }
+      if (!cell->is_artificial())
+        for (unsigned int v = 0; v < n_vertices; ++v)
+          {
+            const unsigned int vertex = cell->vertex_index(v);
+            auto              &here   = recovered[0].averages[vertex];
+            unsigned int       k      = 0;
+            while (k < here.size() && here[k].first != cell->material_id())
+              ++k;
+            if (k == here.size())
+              {
+                for (auto &r : recovered)
+                  r.averages[vertex].emplace_back(cell->material_id(),
+                                                  SymmetricTensor<2, dim>());
+                counts[vertex].push_back(0);
+              }
+            ++counts[vertex][k];
+            if (any_traction)
+              vertex_of_dof[cell->vertex_dof_index(v, 0)] = vertex;
+          }
     // The strains summed over this rank's share of the cells (under
     // mpirun every rank holds the mesh and the solutions: rank r takes the
     // r-th of N contiguous ranges of active cells), then over the ranks.
@@ -129,8 +139,9 @@ namespace knee_contact
                       end   = n_cells * (rank + 1) / ranks;
     for (const auto &cell : dof_handler.active_cell_iterators())
       {
-        if (cell->active_cell_index() < first ||
-            cell->active_cell_index() >= end)
+        if (distributed ? cell->is_artificial()
+                        : cell->active_cell_index() < first ||
+                            cell->active_cell_index() >= end)
           continue;
         nodal.reinit(cell);
         cell->get_dof_indices(cell_dofs);
@@ -160,7 +171,7 @@ namespace knee_contact
               }
           }
       }
-    if (ranks > 1)
+    if (ranks > 1 && !distributed)
       {
         constexpr unsigned int n_components =
           SymmetricTensor<2, dim>::n_independent_components;
@@ -312,12 +323,17 @@ namespace knee_contact
       dof_handler.get_triangulation().n_active_cells();
     const std::size_t first = n_cells * rank / ranks,
                       end   = n_cells * (rank + 1) / ranks;
+    // A distributed mesh: each rank its own cells.
+    const bool distributed =
+      dynamic_cast<const dealii::parallel::TriangulationBase<dim> *>(
+        &dof_handler.get_triangulation()) != nullptr;
     const auto worker =
       [&](const typename DoFHandler<dim>::active_cell_iterator &cell,
           ProductScratch<dim>                                  &scratch,
           ProductCopy                                          &copy) {
-        copy.skip =
-          cell->active_cell_index() < first || cell->active_cell_index() >= end;
+        copy.skip = distributed ? !cell->is_locally_owned()
+                                : cell->active_cell_index() < first ||
+                                    cell->active_cell_index() >= end;
         if (copy.skip)
           return;
         FEValues<dim>     &fe_values = scratch.fe_values;
@@ -412,8 +428,9 @@ namespace knee_contact
         eta_u_squared = sums[0];
         for (unsigned int i = 0; i < n_z; ++i)
           result[i].product = sums[1 + i];
-        // Each cell's indicator was set by one rank, zero on the others.
-        if (with_indicators)
+        // Each cell's indicator was set by one rank, zero on the others (a
+        // distributed mesh's: each rank's own cells, kept where they are).
+        if (with_indicators && !distributed)
           for (auto &r : result)
             Utilities::MPI::sum(
               ArrayView<const float>(r.indicators.begin(), r.indicators.size()),
