@@ -112,6 +112,13 @@ main(int argc, char **argv)
                             mesh.body_of_cell,
                             std::vector<std::string>(n_bodies, "body"));
   say("d and rigid motions");
+  if (rank == 0)
+    std::cerr << "condensed pattern: " << condensed.n_rows() << " rows, "
+              << condensed.n_nonzero_elements()
+              << " entries; the iterative path's estimate "
+              << IterativeContactSystem::estimated_bytes(condensed, false) /
+                   1e6
+              << " MB a rank" << std::endl;
   IterativeContactSystem system(
     condensed,
     [&](const auto &wanted, const auto &add) {

@@ -1591,18 +1591,47 @@ namespace knee_contact
   IterativeContactSystem::estimated_bytes(const SparsityPattern &pattern,
                                           const bool             friction)
   {
-    const double n = pattern.n_rows(), nnz = pattern.n_nonzero_elements();
+    return bytes_of(pattern.n_rows(),
+                    pattern.n_nonzero_elements(),
+                    friction,
+                    parallel::n_ranks() > 1);
+  }
+
+
+
+  double
+  IterativeContactSystem::estimated_bytes(
+    const TrilinosWrappers::SparsityPattern &pattern,
+    const bool                               friction)
+  {
+    // On a distributed mesh the path holds C's rows on any number of
+    // ranks.
+    return bytes_of(pattern.n_rows(),
+                    pattern.n_nonzero_elements(),
+                    friction,
+                    true);
+  }
+
+
+
+  double
+  IterativeContactSystem::bytes_of(const double n,
+                                   const double nnz,
+                                   const bool   friction,
+                                   const bool   holds_c)
+  {
     // Trilinos' matrix of this rank's condensed rows (values and column
     // indices, 12 bytes an entry; condense() sums each row once), the
     // hierarchy (about 10 bytes per fine entry measured with plain
     // aggregation: 150 MB for the knee's 1.48e7 entries); the null space
     // twice (ML's copy), the CG and operator vectors and the condensed
-    // right hand side: about 22 vectors. Several ranks: each also holds its
-    // part of C in Trilinos (12, the operator's); the vectors stay whole
-    // (replicated). With friction GMRES's basis of this rank's rows.
+    // right hand side: about 22 vectors. Several ranks or a distributed
+    // mesh: each rank also holds its part of C in Trilinos (12, the
+    // operator's); the vectors stay whole (replicated). With friction
+    // GMRES's basis of this rank's rows.
     const double ranks = parallel::n_ranks();
     const double basis = friction ? 8. * gmres_basis * n / ranks : 0.;
-    const double of_c  = ranks > 1 ? 12. : 0.;
+    const double of_c  = holds_c ? 12. : 0.;
     return (12. + 10. + of_c) * nnz / ranks + 8. * 22 * n + basis;
   }
 } // namespace knee_contact

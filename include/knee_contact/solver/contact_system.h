@@ -694,6 +694,16 @@ namespace knee_contact
     estimated_bytes(const SparsityPattern &pattern, const bool friction);
 
     /**
+     * The same on a distributed mesh, from every set's condensed pattern
+     * (this rank's rows; its size is the whole pattern's): the path holds
+     * C's rows there on any number of ranks. Measured at 1e6 DoFs:
+     * doc/parallel.md, "The distributed mesh (begun)".
+     */
+    static double
+    estimated_bytes(const TrilinosWrappers::SparsityPattern &pattern,
+                    const bool                               friction);
+
+    /**
      * GMRES's basis with bound couplings (restarted when it is full); it
      * is right preconditioned, so that its residual is the one CG's
      * targets are of. Measured on the 3D knee's stance (34 059 dofs): with
@@ -704,6 +714,14 @@ namespace knee_contact
     static constexpr unsigned int gmres_basis = 60;
 
   private:
+    /** estimated_bytes() from the size of the condensed pattern (@p n
+     * rows, @p nnz entries); @p holds_c: the path holds C's rows. */
+    static double
+    bytes_of(const double n,
+             const double nnz,
+             const bool   friction,
+             const bool   holds_c);
+
     /** All three: C whole (@p matrix) or its rows (@p assemble_rows),
      * on a whole @p pattern or on a distributed mesh's @p distributed_pattern.
      */
