@@ -105,9 +105,6 @@ main(int argc, char **argv)
                                          problem.boundary_conditions_of());
   Vector<double>               d(dofs.n_dofs());
   assembler.assemble_rhs(dofs, d);
-  Utilities::MPI::sum(ArrayView<const double>(d.begin(), d.size()),
-                      comm,
-                      ArrayView<double>(d.begin(), d.size()));
   const RigidModes<3> modes(dofs,
                             mesh.body_of_cell,
                             std::vector<std::string>(n_bodies, "body"));
@@ -116,8 +113,7 @@ main(int argc, char **argv)
     std::cerr << "condensed pattern: " << condensed.n_rows() << " rows, "
               << condensed.n_nonzero_elements()
               << " entries; the iterative path's estimate "
-              << IterativeContactSystem::estimated_bytes(condensed, false) /
-                   1e6
+              << IterativeContactSystem::estimated_bytes(condensed, false) / 1e6
               << " MB a rank" << std::endl;
   IterativeContactSystem system(
     condensed,

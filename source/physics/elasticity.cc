@@ -1,9 +1,11 @@
 #include <knee_contact/physics/elasticity.h>
 #include <knee_contact/physics/elements.h>
 
+#include <deal.II/base/mpi.h>
 #include <deal.II/base/quadrature_lib.h>
 #include <deal.II/base/work_stream.h>
 
+#include <deal.II/distributed/tria_base.h>
 #include <deal.II/fe/fe_values.h>
 
 #include <algorithm>
@@ -113,6 +115,14 @@ namespace knee_contact
     Sinks sinks;
     sinks.rhs = &rhs;
     assemble(dof_handler, sinks);
+    // A distributed mesh: each rank assembled its cells; every rank takes
+    // the whole d (the loop and the results read it whole).
+    if (const auto *distributed =
+          dynamic_cast<const dealii::parallel::TriangulationBase<dim> *>(
+            &dof_handler.get_triangulation()))
+      Utilities::MPI::sum(ArrayView<const double>(rhs.begin(), rhs.size()),
+                          distributed->get_communicator(),
+                          ArrayView<double>(rhs.begin(), rhs.size()));
   }
 
 

@@ -276,9 +276,6 @@ namespace
                                            condensed);
     Vector<double> d(dofs.n_dofs());
     assembler.assemble_rhs(dofs, d);
-    Utilities::MPI::sum(ArrayView<const double>(d.begin(), d.size()),
-                        comm,
-                        ArrayView<double>(d.begin(), d.size()));
     const RigidModes<dim> modes(dofs,
                                 mesh.body_of_cell,
                                 std::vector<std::string>(n_bodies, "body"));

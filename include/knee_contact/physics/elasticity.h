@@ -43,7 +43,9 @@ namespace knee_contact
 
     /**
      * Only the load vector d, for a further load case on the same mesh:
-     * the body forces and tractions at the load parameter last set.
+     * the body forces and tractions at the load parameter last set. On a
+     * distributed mesh each rank assembles its cells and every rank gets
+     * the whole d.
      */
     void
     assemble_rhs(const DoFHandler<dim> &dof_handler, Vector<double> &rhs) const;
