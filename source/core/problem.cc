@@ -1,4 +1,5 @@
 #include <knee_contact/base/input.h>
+#include <knee_contact/base/parallel.h>
 #include <knee_contact/base/scene_file.h>
 #include <knee_contact/core/problem.h>
 #include <knee_contact/core/scene_checks.h>
@@ -276,6 +277,12 @@ namespace knee_contact
   void
   ContactProblem<dim>::make_mesh(const int level)
   {
+    if (distributed)
+      {
+        // The DoF handler lets go of the distributed mesh before it goes.
+        dof_handler.reinit(triangulation);
+        distributed.reset();
+      }
     mesh_input.create(triangulation, level);
     fe =
       elements::displacement_element<dim>(elements::cell_kind(triangulation));
@@ -308,12 +315,53 @@ namespace knee_contact
 
 
   template <int dim>
-  void
-  ContactProblem<dim>::setup_system()
+  std::string
+  ContactProblem<dim>::distribution_reason(const Refinement::Strategy strategy,
+                                           const unsigned int n_cycles) const
   {
-    dof_handler.reinit(triangulation);
-    dof_handler.distribute_dofs(*fe);
-    body_of_cell = compute_body_ids(triangulation, n_bodies);
+    if (parallel::n_ranks() == 1 || strategy != Refinement::Strategy::global ||
+        (n_cycles > 1 && !mesh_input.remeshes(triangulation)) ||
+        !motions.empty() || load_cases.values().size() > 1)
+      return "";
+    for (const auto &interface : contact_interfaces.interfaces())
+      if (interface.friction != Friction::none)
+        return "";
+    const SolverPath path = active_set_solver.linear_solver();
+    if (path == SolverPath::iterative)
+      return "as Contact/Solver says";
+    // The vector element's dofs: dim per vertex.
+    const double n_dofs = double(dim) * triangulation.n_used_vertices();
+    if (path == SolverPath::automatic && dim == 3 &&
+        n_dofs >= min_distributed_dofs)
+      return "automatic: a 3D mesh of " + std::to_string(int(n_dofs)) +
+             " dofs on " + std::to_string(parallel::n_ranks()) +
+             " ranks, at least " + std::to_string(int(min_distributed_dofs)) +
+             "; the direct paths are not analysed";
+    return "";
+  }
+
+
+
+  template <int dim>
+  void
+  ContactProblem<dim>::distribute()
+  {
+    // Every rank made and checked the whole mesh (each refuses bad input
+    // alike); rank 0's is divided and sent, then each frees its copy.
+    name_bodies();
+    distributed = std::make_unique<DistributedMesh<dim>>();
+    distribute_mesh(triangulation, body_of_cell, n_bodies, *distributed);
+    dof_handler.reinit(distributed->triangulation);
+    triangulation.clear();
+    body_of_cell = distributed->body_of_cell;
+  }
+
+
+
+  template <int dim>
+  void
+  ContactProblem<dim>::name_bodies()
+  {
     body_names.assign(n_bodies, "");
     std::vector<std::set<types::material_id>> body_materials(n_bodies);
     for (const auto &cell : triangulation.active_cell_iterators())
@@ -323,9 +371,35 @@ namespace knee_contact
       for (const auto id : body_materials[b])
         body_names[b] +=
           (body_names[b].empty() ? "" : ", ") + materials[id].name;
+  }
+
+
+
+  template <int dim>
+  void
+  ContactProblem<dim>::setup_system()
+  {
+    if (distributed)
+      {
+        // The bodies and their names are the whole mesh's (distribute()).
+        dof_handler.reinit(distributed->triangulation);
+        dof_handler.distribute_dofs(*fe);
+        body_of_cell = distributed->body_of_cell;
+      }
+    else
+      {
+        dof_handler.reinit(triangulation);
+        dof_handler.distribute_dofs(*fe);
+        body_of_cell = compute_body_ids(triangulation, n_bodies);
+        name_bodies();
+      }
 
     boundary_conditions.make_constraints(dof_handler, constraints);
-    contact_pairs = contact_interfaces.make_pairs(dof_handler, constraints);
+    contact_pairs =
+      contact_interfaces.make_pairs(dof_handler,
+                                    constraints,
+                                    distributed ? &distributed->vertex_id
+                                                : nullptr);
     friction_rows.clear();
     if (contact_pairs.frictional())
       friction_rows = contact_pairs.solver_rows();
@@ -340,14 +414,43 @@ namespace knee_contact
         for (unsigned int p = 0; p < at.n_pairs; ++p)
           spring_rows.push_back({at.tangential(0, p), at.tangential(1, p)});
       }
-    DynamicSparsityPattern mesh_pattern(dof_handler.n_dofs());
-    DoFTools::make_sparsity_pattern(dof_handler, mesh_pattern);
-    ActiveSetSolver::make_sparsity_pattern(mesh_pattern,
-                                           constraints,
-                                           rows_for_solver(),
-                                           sparsity_pattern,
-                                           contact_pairs.frictional(),
-                                           spring_rows);
+    if (distributed)
+      {
+        // Each rank's rows, from its cells (the ghosts' entries go to
+        // their owners).
+        const IndexSet owned = dof_handler.locally_owned_dofs();
+        IndexSet       relevant;
+        DoFTools::extract_locally_relevant_dofs(dof_handler, relevant);
+        TrilinosWrappers::SparsityPattern mesh_pattern(
+          owned, owned, relevant, parallel::communicator());
+        DoFTools::make_sparsity_pattern(dof_handler,
+                                        mesh_pattern,
+                                        AffineConstraints<double>(),
+                                        false,
+                                        parallel::rank());
+        mesh_pattern.compress();
+        distributed_pattern =
+          std::make_unique<TrilinosWrappers::SparsityPattern>();
+        ActiveSetSolver::make_sparsity_pattern(mesh_pattern,
+                                               constraints,
+                                               rows_for_solver(),
+                                               *distributed_pattern,
+                                               contact_pairs.frictional(),
+                                               spring_rows);
+        sparsity_pattern.reinit(0, 0, 0);
+      }
+    else
+      {
+        DynamicSparsityPattern mesh_pattern(dof_handler.n_dofs());
+        DoFTools::make_sparsity_pattern(dof_handler, mesh_pattern);
+        ActiveSetSolver::make_sparsity_pattern(mesh_pattern,
+                                               constraints,
+                                               rows_for_solver(),
+                                               sparsity_pattern,
+                                               contact_pairs.frictional(),
+                                               spring_rows);
+        distributed_pattern.reset();
+      }
     // C is made by assemble_system(), whole or as the solver path's rows.
     system_matrix.clear();
     rigid_modes =

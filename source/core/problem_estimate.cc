@@ -1,8 +1,11 @@
 // Goal-oriented error bars of the contact pressures: the influence (dual)
 // solution of a pair's multiplier and its weighting of the recovered strain
 // errors.
+#include <knee_contact/base/parallel.h>
 #include <knee_contact/core/problem.h>
 #include <knee_contact/postprocess/recovery.h>
+
+#include <deal.II/base/mpi.h>
 
 #include <algorithm>
 #include <array>
@@ -335,12 +338,14 @@ namespace knee_contact
     std::map<types::global_dof_index, unsigned int> pair_of_dof;
     for (unsigned int q = 0; q < contact_pairs.size(); ++q)
       pair_of_dof[contact_pairs.points[q].slave_dofs[0]] = q;
+    // On a distributed mesh each rank sees its own cells' faces (each
+    // boundary face once); the crossings are gathered below.
     std::set<std::pair<unsigned int, unsigned int>> edges;
     std::set<unsigned int>                          outline;
     std::vector<double> bars(results.interfaces.size(), 0.);
     for (const auto &cell : dof_handler.active_cell_iterators())
       for (const auto &face : cell->face_iterators())
-        if (face->at_boundary())
+        if (cell->is_locally_owned() && face->at_boundary())
           {
             std::vector<unsigned int> face_pairs;
             for (const unsigned int v : face->vertex_indices())
@@ -356,15 +361,26 @@ namespace knee_contact
                     contact_pairs.rows[a].interface ==
                       contact_pairs.rows[b].interface &&
                     edges.emplace(a, b).second)
-                  {
-                    if constexpr (dim == 2)
-                      bars[contact_pairs.rows[a].interface] +=
-                        0.5 * (contact_pairs.rows[a].length +
-                               contact_pairs.rows[b].length);
-                    else
-                      outline.insert({a, b});
-                  }
+                  outline.insert({a, b});
           }
+    if (distributed)
+      {
+        std::vector<unsigned int> mine;
+        for (const auto &[a, b] : edges)
+          mine.insert(mine.end(), {a, b});
+        for (const auto &part :
+             Utilities::MPI::all_gather(parallel::communicator(), mine))
+          for (std::size_t i = 0; i + 1 < part.size(); i += 2)
+            if (edges.emplace(part[i], part[i + 1]).second)
+              outline.insert({part[i], part[i + 1]});
+      }
+    if constexpr (dim == 2)
+      {
+        for (const auto &[a, b] : edges)
+          bars[contact_pairs.rows[a].interface] +=
+            0.5 * (contact_pairs.rows[a].length + contact_pairs.rows[b].length);
+        outline.clear();
+      }
     // 3D: the zone's outline is a band, one spacing wide: half the share of
     // every vertex on either side of it, each once. (Summed per crossing
     // pair, as in 2D, a vertex with two or three neighbours across counted
@@ -421,89 +437,139 @@ namespace knee_contact
       typename DoFHandler<dim>::active_cell_iterator cell;
       unsigned int                                   vertex = 0;
     };
+    // On a distributed mesh each rank takes the extremes of its own cells
+    // (the recovery is valid at their vertices), then the ranks' are
+    // compared below.
     // By material: tau_yy min (as -tau_yy max), tau_yy max, von Mises max.
     std::map<types::material_id, std::array<Extreme, 3>> extremes;
     const unsigned int                                   n_vertices =
       dof_handler.get_fe().reference_cell().n_vertices();
     for (const auto &cell : dof_handler.active_cell_iterators())
-      {
-        const types::material_id id       = cell->material_id();
-        const Material<dim>     &material = materials[id];
-        auto                    &e        = extremes[id];
-        for (unsigned int v = 0; v < n_vertices; ++v)
-          {
-            const SymmetricTensor<2, dim> stress =
-              material.stress(recovered(cell->vertex_index(v), id));
-            const double syy =
-              results.stress_yy_at(cell->active_cell_index(), v);
-            const std::array<double, 3> fe = {
-              {-syy, syy, results.von_mises_at(cell->active_cell_index(), v)}};
-            const std::array<double, 3> star = {
-              {-stress[1][1], stress[1][1], material.von_mises(stress)}};
-            for (unsigned int k = 0; k < 3; ++k)
-              {
-                if (!e[k].set || fe[k] > e[k].fe)
-                  {
-                    e[k].fe              = fe[k];
-                    e[k].recovered_there = star[k];
-                    e[k].cell            = cell;
-                    e[k].vertex          = cell->vertex_index(v);
-                  }
-                e[k].recovered =
-                  e[k].set ? std::max(e[k].recovered, star[k]) : star[k];
-                e[k].set = true;
-              }
-          }
-      }
-    // How many cells of its material meet each extreme's vertex: one
-    // means a corner of the body or of a material region, where the
-    // stress is often singular (flagged).
+      if (cell->is_locally_owned())
+        {
+          const types::material_id id       = cell->material_id();
+          const Material<dim>     &material = materials[id];
+          auto                    &e        = extremes[id];
+          for (unsigned int v = 0; v < n_vertices; ++v)
+            {
+              const SymmetricTensor<2, dim> stress =
+                material.stress(recovered(cell->vertex_index(v), id));
+              const double syy =
+                results.stress_yy_at(cell->active_cell_index(), v);
+              const std::array<double, 3> fe = {
+                {-syy,
+                 syy,
+                 results.von_mises_at(cell->active_cell_index(), v)}};
+              const std::array<double, 3> star = {
+                {-stress[1][1], stress[1][1], material.von_mises(stress)}};
+              for (unsigned int k = 0; k < 3; ++k)
+                {
+                  if (!e[k].set || fe[k] > e[k].fe)
+                    {
+                      e[k].fe              = fe[k];
+                      e[k].recovered_there = star[k];
+                      e[k].cell            = cell;
+                      e[k].vertex          = cell->vertex_index(v);
+                    }
+                  e[k].recovered =
+                    e[k].set ? std::max(e[k].recovered, star[k]) : star[k];
+                  e[k].set = true;
+                }
+            }
+        }
+    // How many cells of its material meet each extreme's vertex (its cells
+    // are this rank's or ghosts): one means a corner of the body or of a
+    // material region, where the stress is often singular (flagged).
     std::map<std::pair<unsigned int, types::material_id>, unsigned int>
       cells_at;
     for (const auto &[id, e] : extremes)
       for (const Extreme &x : e)
         cells_at[{x.vertex, id}] = 0;
     for (const auto &cell : dof_handler.active_cell_iterators())
-      for (const unsigned int v : cell->vertex_indices())
-        {
-          const auto found =
-            cells_at.find({cell->vertex_index(v), cell->material_id()});
-          if (found != cells_at.end())
-            ++found->second;
-        }
-    for (const auto &[id, e] : extremes)
-      {
-        const std::array<std::string, 3> names = {
-          {": tau_yy min", ": tau_yy max", ": von Mises max"}};
-        for (unsigned int k = 0; k < 3; ++k)
+      if (!cell->is_artificial())
+        for (const unsigned int v : cell->vertex_indices())
           {
-            ErrorEstimate bar;
-            bar.value = k == 0 ? -e[k].fe : e[k].fe;
-            // The recovered stress's range over the extreme's cell.
-            double low  = std::numeric_limits<double>::max(),
-                   high = -std::numeric_limits<double>::max();
-            for (unsigned int v = 0; v < n_vertices; ++v)
-              {
-                const SymmetricTensor<2, dim> stress = materials[id].stress(
-                  recovered(e[k].cell->vertex_index(v), id));
-                const double star =
-                  k == 2 ? materials[id].von_mises(stress) : stress[1][1];
-                low  = std::min(low, star);
-                high = std::max(high, star);
-              }
-            bar.error =
-              1.5 * std::max({std::abs(e[k].fe - e[k].recovered_there),
-                              std::abs(e[k].fe - e[k].recovered),
-                              high - low});
-            bar.asymptotic = cells_at.at({e[k].vertex, id}) > 1;
-            bar.basis = "one mesh: the recovered stress at the extreme, its "
-                        "own extreme and its range over the extreme's cell";
-            if (!bar.asymptotic)
-              bar.basis += "; the extreme lies at a corner (one cell of the "
-                           "material at its vertex), where the stress is "
-                           "often singular: a rough bar";
-            keep(materials[id].name + names[k], bar);
+            const auto found =
+              cells_at.find({cell->vertex_index(v), cell->material_id()});
+            if (found != cells_at.end())
+              ++found->second;
           }
+    // Each extreme as numbers: material, kind, the value, the recovered
+    // stress there, the recovered field's own extreme, the recovered
+    // stress's range over the extreme's cell and the cells at its vertex.
+    constexpr unsigned int width = 7;
+    std::vector<double>    found;
+    for (const auto &[id, e] : extremes)
+      for (unsigned int k = 0; k < 3; ++k)
+        {
+          double low  = std::numeric_limits<double>::max(),
+                 high = -std::numeric_limits<double>::max();
+          for (unsigned int v = 0; v < n_vertices; ++v)
+            {
+              const SymmetricTensor<2, dim> stress =
+                materials[id].stress(recovered(e[k].cell->vertex_index(v), id));
+              const double star =
+                k == 2 ? materials[id].von_mises(stress) : stress[1][1];
+              low  = std::min(low, star);
+              high = std::max(high, star);
+            }
+          found.insert(found.end(),
+                       {double(id),
+                        double(k),
+                        e[k].fe,
+                        e[k].recovered_there,
+                        e[k].recovered,
+                        high - low,
+                        double(cells_at.at({e[k].vertex, id}))});
+        }
+    if (distributed)
+      {
+        // The largest over the ranks (the lowest rank's where equal); the
+        // recovered field's own extreme the largest of all.
+        std::vector<double> all;
+        for (const auto &part :
+             Utilities::MPI::all_gather(parallel::communicator(), found))
+          all.insert(all.end(), part.begin(), part.end());
+        std::map<std::pair<int, int>, std::vector<double>> best;
+        for (std::size_t i = 0; i < all.size(); i += width)
+          {
+            const std::vector<double> x(all.begin() + i,
+                                        all.begin() + i + width);
+            auto [at, added] =
+              best.emplace(std::make_pair(int(x[0]), int(x[1])), x);
+            if (!added)
+              {
+                const double recovered_max = std::max(at->second[4], x[4]);
+                if (x[2] > at->second[2])
+                  at->second = x;
+                at->second[4] = recovered_max;
+              }
+          }
+        found.clear();
+        for (const auto &[key, x] : best)
+          found.insert(found.end(), x.begin(), x.end());
+      }
+    const std::array<std::string, 3> names = {
+      {": tau_yy min", ": tau_yy max", ": von Mises max"}};
+    for (std::size_t i = 0; i < found.size(); i += width)
+      {
+        const types::material_id id = types::material_id(found[i]);
+        const unsigned int       k  = static_cast<unsigned int>(found[i + 1]);
+        const double fe = found[i + 2], recovered_there = found[i + 3],
+                     recovered_extreme = found[i + 4], range = found[i + 5];
+        ErrorEstimate bar;
+        bar.value      = k == 0 ? -fe : fe;
+        bar.error      = 1.5 * std::max({std::abs(fe - recovered_there),
+                                         std::abs(fe - recovered_extreme),
+                                         range});
+        bar.asymptotic = found[i + 6] > 1;
+        bar.basis      = "one mesh: the recovered stress at the extreme, its "
+                         "own extreme and its range over the extreme's cell";
+        if (!bar.asymptotic)
+          bar.basis += "; the extreme lies at a corner (one cell of the "
+                       "material at its vertex), where the stress is "
+                       "often singular: a rough bar";
+        keep(materials[id].name + names[k], bar);
       }
   }
 

@@ -33,12 +33,29 @@ namespace knee_contact
                               contact_solution,
                               results);
     };
+    // On a distributed mesh the cells' file is gathered from every rank
+    // (one collective call), before the VTU's pieces are sent on another
+    // thread: MPI is not called from two threads at once.
+    const auto write_cells = [&]() {
+      TimerOutput::Scope part(timer,
+                              dim == 2 ? "output: cells.npy"
+                                       : "output: surface.npy");
+      output_writer.write_cells(dof_handler,
+                                body_of_cell,
+                                displacement,
+                                results);
+    };
     if (!output_writer.enabled())
       {
-        // Another rank than 0 under mpirun: its pieces of solution.vtu.
+        // Another rank than 0 under mpirun: its pieces of solution.vtu,
+        // and on a distributed mesh its rows of the cells' file.
+        if (distributed)
+          write_cells();
         write_vtu();
         return;
       }
+    if (distributed)
+      write_cells();
     // Declared first: if anything below throws, its destructor waits for
     // the VTU thread before the objects it reads go.
     std::future<void> vtu;
@@ -50,15 +67,8 @@ namespace knee_contact
       // made, and joined before the folder is committed; everything it
       // reads is read-only by then.
       vtu = std::async(std::launch::async, write_vtu);
-      {
-        TimerOutput::Scope part(timer,
-                                dim == 2 ? "output: cells.npy"
-                                         : "output: surface.npy");
-        output_writer.write_cells(dof_handler,
-                                  body_of_cell,
-                                  displacement,
-                                  results);
-      }
+      if (!distributed)
+        write_cells();
       TimerOutput::Scope part(timer, "output: csv");
       output_writer.write_contact_csv(contact_interfaces,
                                       contact_pairs,
@@ -81,12 +91,12 @@ namespace knee_contact
     solver_figures["peak_memory_MB"] = memory.VmHWM / 1024.;
     // Where the memory goes (deal.II's own accounting of its objects; the
     // solver's factor is factor_memory_MB).
-    solver_figures["memory_mesh_MB"] =
-      triangulation.memory_consumption() / 1048576.;
+    solver_figures["memory_mesh_MB"] = mesh().memory_consumption() / 1048576.;
     solver_figures["memory_dofs_MB"] =
       dof_handler.memory_consumption() / 1048576.;
     solver_figures["memory_matrix_MB"] =
       (sparsity_pattern.memory_consumption() +
+       (distributed_pattern ? distributed_pattern->memory_consumption() : 0) +
        system_matrix.memory_consumption()) /
       1048576.;
     // The pictures read summary.json; a picture failure is kept in it

@@ -68,8 +68,8 @@ namespace knee_contact
           if (cycle == 0)
             make_mesh(0);
           else if (strategy == Refinement::Strategy::global &&
-                   mesh_input.remeshes(triangulation))
-            make_mesh(cycle);
+                   (distributed || mesh_input.remeshes(triangulation)))
+            make_mesh(cycle); // a distributed mesh is one that remeshes
           else
             {
               // A refined mesh keeps its pose; its new vertices would lie
@@ -89,6 +89,10 @@ namespace knee_contact
           scene_checks::check_finite_data(triangulation,
                                           materials,
                                           boundary_conditions);
+          distributed_reason =
+            resolved ? std::string() : distribution_reason(strategy, n_cycles);
+          if (!distributed_reason.empty())
+            distribute();
         });
         if (resolved)
           {
@@ -102,10 +106,13 @@ namespace knee_contact
             break;
           }
         timed("setup", [&]() { setup_system(); });
-        std::cout << record.strategy << " cycle " << cycle << ": "
-                  << triangulation.n_active_cells() << " cells, "
-                  << dof_handler.n_dofs() << " dofs, " << n_bodies
+        std::cout << record.strategy << " cycle " << cycle << ": " << n_cells()
+                  << " cells, " << dof_handler.n_dofs() << " dofs, " << n_bodies
                   << " bodies, " << contact_pairs.size() << " contact pairs"
+                  << (distributed
+                        ? ", the mesh distributed over " +
+                            std::to_string(parallel::n_ranks()) + " ranks"
+                        : std::string())
                   << std::endl;
         timed("assembly",
               [&]() { assemble_system(!previous_contact.empty()); });
@@ -123,7 +130,7 @@ namespace knee_contact
         });
 
         keep_contact_zone();
-        record.n_cells        = triangulation.n_active_cells();
+        record.n_cells        = n_cells();
         record.n_dofs         = dof_handler.n_dofs();
         record.n_pairs        = contact_pairs.size();
         record.n_iterations   = contact_solution.n_iterations;
@@ -555,7 +562,20 @@ namespace knee_contact
     // The previous system (its factor) goes before the new one is made.
     contact_system.reset();
     system_matrix.clear();
-    Timer clock;
+    Timer                          clock;
+    const ElasticityAssembler<dim> assembler(materials, boundary_conditions);
+    if (distributed)
+      {
+        // The path that runs on the distributed mesh: C's rows from each
+        // rank's cells, d whole (each rank's cells summed over the ranks).
+        solver_plan = plan_contact_system(*distributed_pattern,
+                                          rows_for_solver(),
+                                          distributed_reason);
+        solver_plan.figures["choice"] = clock.wall_time();
+        assembler.assemble_rhs(dof_handler, system_rhs);
+        make_solver();
+        return;
+      }
     solver_plan = plan_contact_system(active_set_solver.linear_solver(),
                                       sparsity_pattern,
                                       system_matrix,
@@ -564,7 +584,6 @@ namespace knee_contact
                                       active_set_solver.direct_factor(),
                                       warm_start);
     solver_plan.figures["choice"] = clock.wall_time();
-    const ElasticityAssembler<dim> assembler(materials, boundary_conditions);
     if (!solver_plan.rows_only)
       {
         system_matrix.reinit(sparsity_pattern);
@@ -594,15 +613,23 @@ namespace knee_contact
     };
     const bool   rows_only = solver_plan.rows_only;
     SolverChoice choice =
-      make_contact_system(std::move(solver_plan),
-                          sparsity_pattern,
-                          system_matrix,
-                          rows_only ? &rows : nullptr,
-                          constraints,
-                          rows_for_solver(),
-                          *rigid_modes,
-                          active_set_solver.krylov_settings(),
-                          log);
+      distributed ? make_contact_system(std::move(solver_plan),
+                                        *distributed_pattern,
+                                        rows,
+                                        constraints,
+                                        rows_for_solver(),
+                                        *rigid_modes,
+                                        active_set_solver.krylov_settings(),
+                                        log)
+                  : make_contact_system(std::move(solver_plan),
+                                        sparsity_pattern,
+                                        system_matrix,
+                                        rows_only ? &rows : nullptr,
+                                        constraints,
+                                        rows_for_solver(),
+                                        *rigid_modes,
+                                        active_set_solver.krylov_settings(),
+                                        log);
     contact_system = std::move(choice.system);
     solver_name    = std::move(choice.name);
     solver_figures = std::move(choice.figures);

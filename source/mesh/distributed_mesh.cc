@@ -99,9 +99,12 @@ namespace knee_contact
     mesh.triangulation.create_triangulation(description);
     mesh.n_bodies = n_bodies;
     mesh.body_of_cell.assign(mesh.triangulation.n_active_cells(), 0);
+    // A rank without cells holds deal.II's one artificial dummy cell,
+    // which has no id.
     for (const auto &cell : mesh.triangulation.active_cell_iterators())
-      mesh.body_of_cell[cell->active_cell_index()] =
-        body_of_id.at(cell->id().get_coarse_cell_id());
+      if (!cell->is_artificial())
+        mesh.body_of_cell[cell->active_cell_index()] =
+          body_of_id.at(cell->id().get_coarse_cell_id());
     // The mesh keeps the description's vertices in its order (checked, not
     // documented by deal.II); refinement's vertices have no whole index.
     mesh.vertex_id.assign(mesh.triangulation.n_vertices(),

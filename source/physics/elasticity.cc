@@ -158,16 +158,19 @@ namespace knee_contact
                                            &cell,
                           ScratchData<dim> &scratch,
                           CopyData         &copy) {
+      // On a distributed mesh (DistributedMesh) a rank assembles the cells
+      // it owns, not its ghosts: their owners do (a whole mesh's cells are
+      // all owned). A rank without cells has an artificial one, without
+      // dofs.
+      copy.skipped = !cell->is_locally_owned();
+      if (copy.skipped)
+        return;
       const FiniteElement<dim> &fe       = cell->get_fe();
       const unsigned int        n        = fe.n_dofs_per_cell();
       const Material<dim>      &material = materials[cell->material_id()];
       copy.dof_indices.resize(n);
       cell->get_dof_indices(copy.dof_indices);
-      // On a distributed mesh (DistributedMesh) a rank assembles the cells
-      // it owns, not its ghosts: their owners do (a whole mesh's cells are
-      // all owned).
-      copy.skipped = !cell->is_locally_owned() ||
-                     (sinks.wanted != nullptr &&
+      copy.skipped = (sinks.wanted != nullptr &&
                       std::none_of(copy.dof_indices.begin(),
                                    copy.dof_indices.end(),
                                    [&](const types::global_dof_index i) {

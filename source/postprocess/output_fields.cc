@@ -4,6 +4,9 @@
 #include <knee_contact/physics/elements.h>
 #include <knee_contact/postprocess/output.h>
 
+#include <deal.II/base/mpi.h>
+
+#include <deal.II/distributed/tria_base.h>
 #include <deal.II/numerics/data_out.h>
 #include <deal.II/numerics/data_postprocessor.h>
 
@@ -276,32 +279,72 @@ namespace knee_contact
     // memory is that of one piece.
     //
     // Under mpirun every rank holds the solution, and building a piece
-    // (DataOut's patches and zlib) is the output's time: piece i is built
-    // by rank i mod N, which sends its bytes to rank 0, the one that writes
-    // the folder (no shared file system is assumed). The number of pieces
-    // is a multiple of N, so every rank builds as many (7 pieces of
-    // 446 206 cells on two ranks took 5.5 s, 8 pieces 2.1 s); the file is
-    // one solution.vtu, as on one process.
+    // (DataOut's patches and zlib) is the output's time: on a whole mesh
+    // piece i is built by rank i mod N, which sends its bytes to rank 0, the
+    // one that writes the folder (no shared file system is assumed). The
+    // number of pieces is a multiple of N, so every rank builds as many (7
+    // pieces of 446 206 cells on two ranks took 5.5 s, 8 pieces 2.1 s); the
+    // file is one solution.vtu, as on one process. On a distributed mesh
+    // each rank builds the pieces of its own cells, rank by rank.
     const unsigned int ranks = parallel::n_ranks(), rank = parallel::rank();
     const unsigned int n_cells =
       dof_handler.get_triangulation().n_active_cells();
-    const unsigned int n_pieces =
-      (n_cells + std::size_t(cells_per_piece) * ranks - 1) /
-      (std::size_t(cells_per_piece) * ranks) * ranks;
-    const unsigned int per_piece = (n_cells + n_pieces - 1) / n_pieces;
-    std::vector<typename Triangulation<dim>::active_cell_iterator> first(
-      n_pieces);
-    std::vector<bool> has_cells(n_pieces, false);
-    for (const auto &cell : dof_handler.active_cell_iterators())
-      if (cell->active_cell_index() % per_piece == 0)
-        {
-          first[cell->active_cell_index() / per_piece]     = cell;
-          has_cells[cell->active_cell_index() / per_piece] = true;
-        }
+    // Each piece: its rank, and on that rank its first cell and the index
+    // its cells stay below (this rank's cells between them).
+    std::vector<unsigned int>                                      owner;
+    std::vector<typename Triangulation<dim>::active_cell_iterator> first;
+    std::vector<unsigned int>                                      end_index;
+    if (dynamic_cast<const dealii::parallel::TriangulationBase<dim> *>(
+          &dof_handler.get_triangulation()) == nullptr)
+      {
+        const unsigned int n_pieces =
+          (n_cells + std::size_t(cells_per_piece) * ranks - 1) /
+          (std::size_t(cells_per_piece) * ranks) * ranks;
+        const unsigned int per_piece = (n_cells + n_pieces - 1) / n_pieces;
+        first.resize(n_pieces, dof_handler.get_triangulation().end());
+        for (unsigned int piece = 0; piece < n_pieces; ++piece)
+          {
+            owner.push_back(piece % ranks);
+            end_index.push_back(
+              std::min<std::size_t>(n_cells,
+                                    std::size_t(piece + 1) * per_piece));
+          }
+        for (const auto &cell : dof_handler.active_cell_iterators())
+          if (cell->active_cell_index() % per_piece == 0)
+            first[cell->active_cell_index() / per_piece] = cell;
+      }
+    else
+      {
+        std::vector<typename Triangulation<dim>::active_cell_iterator> own;
+        for (const auto &cell : dof_handler.active_cell_iterators())
+          if (cell->is_locally_owned())
+            own.push_back(cell);
+        // At least one piece a rank (perhaps empty: more ranks than cells).
+        const unsigned int mine = std::max<std::size_t>(
+          1, (own.size() + cells_per_piece - 1) / cells_per_piece);
+        const std::vector<unsigned int> counts =
+          Utilities::MPI::all_gather(parallel::communicator(), mine);
+        for (unsigned int r = 0; r < ranks; ++r)
+          for (unsigned int k = 0; k < counts[r]; ++k)
+            {
+              owner.push_back(r);
+              first.push_back(dof_handler.get_triangulation().end());
+              end_index.push_back(0);
+              if (r != rank)
+                continue;
+              const std::size_t begin = std::size_t(k) * cells_per_piece;
+              if (begin < own.size())
+                first.back() = own[begin];
+              end_index.back() =
+                begin + cells_per_piece < own.size()
+                  ? own[begin + cells_per_piece]->active_cell_index()
+                  : n_cells;
+            }
+      }
+    const unsigned int n_pieces = owner.size();
     const auto build = [&](const unsigned int piece, std::ostream &out) {
-      const unsigned int end =
-        std::min<std::size_t>(n_cells, std::size_t(piece + 1) * per_piece);
-      if (!has_cells[piece])
+      const unsigned int end = end_index[piece];
+      if (first[piece] == dof_handler.get_triangulation().end())
         return; // more ranks than cells: an empty piece
       using cell_iterator = typename DataOut<dim>::cell_iterator;
       data_out.set_cell_selection(
@@ -312,6 +355,8 @@ namespace knee_contact
               const cell_iterator      &cell) -> cell_iterator {
           typename Triangulation<dim>::active_cell_iterator next(cell);
           ++next;
+          while (next != triangulation.end() && !next->is_locally_owned())
+            ++next;
           if (next == triangulation.end() || next->active_cell_index() >= end)
             return triangulation.end();
           return next;
@@ -326,21 +371,22 @@ namespace knee_contact
     if (rank != 0)
       {
         // A helper: its pieces' bytes, one message each (tag: the piece).
-        for (unsigned int piece = rank; piece < n_pieces; piece += ranks)
-          {
-            std::ostringstream bytes;
-            build(piece, bytes);
-            const std::string text = bytes.str();
-            AssertThrow(text.size() < std::size_t(INT_MAX),
-                        ExcMessage("a VTU piece of over 2 GB: lower Output/"
-                                   "Cells per VTU piece"));
-            MPI_Send(text.data(),
-                     int(text.size()),
-                     MPI_CHAR,
-                     0,
-                     int(piece),
-                     parallel::communicator());
-          }
+        for (unsigned int piece = 0; piece < n_pieces; ++piece)
+          if (owner[piece] == rank)
+            {
+              std::ostringstream bytes;
+              build(piece, bytes);
+              const std::string text = bytes.str();
+              AssertThrow(text.size() < std::size_t(INT_MAX),
+                          ExcMessage("a VTU piece of over 2 GB: lower Output/"
+                                     "Cells per VTU piece"));
+              MPI_Send(text.data(),
+                       int(text.size()),
+                       MPI_CHAR,
+                       0,
+                       int(piece),
+                       parallel::communicator());
+            }
         return;
       }
     // Rank 0: the pieces in order, its own built here, the others'
@@ -349,7 +395,7 @@ namespace knee_contact
     unsigned int next    = 0;
     const auto   receive = [&](const unsigned int piece) {
       MPI_Status status;
-      MPI_Probe(int(piece % ranks),
+      MPI_Probe(int(owner[piece]),
                 int(piece),
                 parallel::communicator(),
                 &status);
@@ -359,7 +405,7 @@ namespace knee_contact
       MPI_Recv(text.data(),
                size,
                MPI_CHAR,
-               int(piece % ranks),
+               int(owner[piece]),
                int(piece),
                parallel::communicator(),
                MPI_STATUS_IGNORE);
@@ -370,7 +416,7 @@ namespace knee_contact
         write_file("solution.vtu", [&](std::ostream &out) {
           DataOutBase::write_vtu_header(out, flags);
           for (; next < n_pieces; ++next)
-            if (next % ranks == 0)
+            if (owner[next] == 0)
               build(next, out);
             else
               {
@@ -383,7 +429,7 @@ namespace knee_contact
     catch (...)
       {
         for (; next < n_pieces; ++next)
-          if (next % ranks != 0)
+          if (owner[next] != 0)
             receive(next);
         throw;
       }
@@ -412,24 +458,25 @@ namespace knee_contact
           std::size_t(dof_handler.get_triangulation().n_active_cells()) *
           n_columns);
         for (const auto &cell : dof_handler.active_cell_iterators())
-          {
-            data.push_back(cell->material_id());
-            data.push_back(body_of_cell[cell->active_cell_index()]);
-            // Counter-clockwise: deal.II's vertex order is 0 1 3 2 on a
-            // quadrilateral, 0 1 2 on a triangle.
-            const bool triangle = cell->n_vertices() == 3;
-            for (const unsigned int v :
-                 triangle ? std::array<unsigned int, 4>{{0, 1, 2, 2}}
-                          : std::array<unsigned int, 4>{{0, 1, 3, 2}})
-              {
-                data.push_back(cell->vertex(v)[0]);
-                data.push_back(cell->vertex(v)[1]);
-                data.push_back(solution(cell->vertex_dof_index(v, 0)));
-                data.push_back(solution(cell->vertex_dof_index(v, 1)));
-                data.push_back(
-                  results.stress_yy_at(cell->active_cell_index(), v));
-              }
-          }
+          if (cell->is_locally_owned())
+            {
+              data.push_back(cell->material_id());
+              data.push_back(body_of_cell[cell->active_cell_index()]);
+              // Counter-clockwise: deal.II's vertex order is 0 1 3 2 on a
+              // quadrilateral, 0 1 2 on a triangle.
+              const bool triangle = cell->n_vertices() == 3;
+              for (const unsigned int v :
+                   triangle ? std::array<unsigned int, 4>{{0, 1, 2, 2}}
+                            : std::array<unsigned int, 4>{{0, 1, 3, 2}})
+                {
+                  data.push_back(cell->vertex(v)[0]);
+                  data.push_back(cell->vertex(v)[1]);
+                  data.push_back(solution(cell->vertex_dof_index(v, 0)));
+                  data.push_back(solution(cell->vertex_dof_index(v, 1)));
+                  data.push_back(
+                    results.stress_yy_at(cell->active_cell_index(), v));
+                }
+            }
       }
     else
       {
@@ -440,7 +487,7 @@ namespace knee_contact
         n_columns = 2 + 4 * 7;
         for (const auto &cell : dof_handler.active_cell_iterators())
           for (const unsigned int f : cell->face_indices())
-            if (cell->face(f)->at_boundary())
+            if (cell->is_locally_owned() && cell->face(f)->at_boundary())
               {
                 data.push_back(cell->material_id());
                 data.push_back(body_of_cell[cell->active_cell_index()]);
@@ -464,6 +511,19 @@ namespace knee_contact
                       results.von_mises_at(cell->active_cell_index(), v));
                   }
               }
+      }
+    if (dynamic_cast<const dealii::parallel::TriangulationBase<dim> *>(
+          &dof_handler.get_triangulation()) != nullptr)
+      {
+        // A distributed mesh: each rank's rows to rank 0, which writes them
+        // (in rank order; the picture does not depend on the rows' order).
+        const std::vector<std::vector<float>> all =
+          Utilities::MPI::gather(parallel::communicator(), data, 0);
+        if (!write_files)
+          return;
+        data.clear();
+        for (const auto &rows : all)
+          data.insert(data.end(), rows.begin(), rows.end());
       }
     const std::string name = dim == 2 ? "cells.npy" : "surface.npy";
     write_file(name,

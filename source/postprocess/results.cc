@@ -48,6 +48,9 @@ namespace knee_contact
       body_of_cell.empty()
         ? 0
         : *std::max_element(body_of_cell.begin(), body_of_cell.end()) + 1;
+    if (distributed != nullptr)
+      results.n_bodies =
+        Utilities::MPI::max(results.n_bodies, distributed->get_communicator());
 
     // The force each dof's vertex receives from its supports: the
     // residual d - C x of the unconstrained system minus the contact forces

@@ -1,9 +1,12 @@
 #include <knee_contact/base/input.h>
+#include <knee_contact/base/parallel.h>
 #include <knee_contact/physics/elements.h>
 #include <knee_contact/postprocess/verification.h>
 
+#include <deal.II/base/mpi.h>
 #include <deal.II/base/quadrature_lib.h>
 
+#include <deal.II/distributed/tria_base.h>
 #include <deal.II/fe/fe_values.h>
 
 #include <algorithm>
@@ -234,54 +237,72 @@ namespace knee_contact
         Vector<double> stress_values(components.size());
         double         l2 = 0, l2_norm = 0, energy = 0, energy_norm = 0;
         double         stress_error = 0, stress_max = 0;
+        // On a distributed mesh each rank its own cells, summed and
+        // maximised over the ranks below.
         for (const auto &cell : dof_handler.active_cell_iterators())
+          if (cell->is_locally_owned())
+            {
+              fe_values.reinit(cell);
+              fe_values[u].get_function_values(solution, values);
+              fe_values[u].get_function_symmetric_gradients(solution, strains);
+              const Material<dim> &material = materials[cell->material_id()];
+              if (exact_displacement)
+                {
+                  exact_displacement->vector_value_list(
+                    fe_values.get_quadrature_points(), exact_values);
+                  exact_displacement->vector_gradient_list(
+                    fe_values.get_quadrature_points(), exact_gradients);
+                }
+              for (unsigned int q = 0; q < n_q; ++q)
+                {
+                  if (exact_displacement)
+                    {
+                      SymmetricTensor<2, dim> exact_strain;
+                      for (unsigned int i = 0; i < dim; ++i)
+                        for (unsigned int j = i; j < dim; ++j)
+                          exact_strain[i][j] = 0.5 * (exact_gradients[q][i][j] +
+                                                      exact_gradients[q][j][i]);
+                      Tensor<1, dim> exact;
+                      for (unsigned int d = 0; d < dim; ++d)
+                        exact[d] = exact_values[q](d);
+                      const SymmetricTensor<2, dim> e =
+                        strains[q] - exact_strain;
+                      l2 +=
+                        (values[q] - exact).norm_square() * fe_values.JxW(q);
+                      l2_norm += exact.norm_square() * fe_values.JxW(q);
+                      energy += material.stress(e) * e * fe_values.JxW(q);
+                      energy_norm += material.stress(exact_strain) *
+                                     exact_strain * fe_values.JxW(q);
+                    }
+                  if (exact_stress)
+                    {
+                      exact_stress->vector_value(fe_values.quadrature_point(q),
+                                                 stress_values);
+                      const auto s = material.stress(strains[q]);
+                      for (unsigned int c = 0; c < components.size(); ++c)
+                        {
+                          const auto [i, j] = components[c];
+                          stress_error =
+                            std::max(stress_error,
+                                     std::abs(s[i][j] - stress_values(c)));
+                          stress_max =
+                            std::max(stress_max, std::abs(stress_values(c)));
+                        }
+                    }
+                }
+            }
+        const bool distributed =
+          dynamic_cast<const dealii::parallel::TriangulationBase<dim> *>(
+            &dof_handler.get_triangulation()) != nullptr;
+        if (distributed)
           {
-            fe_values.reinit(cell);
-            fe_values[u].get_function_values(solution, values);
-            fe_values[u].get_function_symmetric_gradients(solution, strains);
-            const Material<dim> &material = materials[cell->material_id()];
-            if (exact_displacement)
-              {
-                exact_displacement->vector_value_list(
-                  fe_values.get_quadrature_points(), exact_values);
-                exact_displacement->vector_gradient_list(
-                  fe_values.get_quadrature_points(), exact_gradients);
-              }
-            for (unsigned int q = 0; q < n_q; ++q)
-              {
-                if (exact_displacement)
-                  {
-                    SymmetricTensor<2, dim> exact_strain;
-                    for (unsigned int i = 0; i < dim; ++i)
-                      for (unsigned int j = i; j < dim; ++j)
-                        exact_strain[i][j] = 0.5 * (exact_gradients[q][i][j] +
-                                                    exact_gradients[q][j][i]);
-                    Tensor<1, dim> exact;
-                    for (unsigned int d = 0; d < dim; ++d)
-                      exact[d] = exact_values[q](d);
-                    const SymmetricTensor<2, dim> e = strains[q] - exact_strain;
-                    l2 += (values[q] - exact).norm_square() * fe_values.JxW(q);
-                    l2_norm += exact.norm_square() * fe_values.JxW(q);
-                    energy += material.stress(e) * e * fe_values.JxW(q);
-                    energy_norm += material.stress(exact_strain) *
-                                   exact_strain * fe_values.JxW(q);
-                  }
-                if (exact_stress)
-                  {
-                    exact_stress->vector_value(fe_values.quadrature_point(q),
-                                               stress_values);
-                    const auto s = material.stress(strains[q]);
-                    for (unsigned int c = 0; c < components.size(); ++c)
-                      {
-                        const auto [i, j] = components[c];
-                        stress_error =
-                          std::max(stress_error,
-                                   std::abs(s[i][j] - stress_values(c)));
-                        stress_max =
-                          std::max(stress_max, std::abs(stress_values(c)));
-                      }
-                  }
-              }
+            const MPI_Comm comm = parallel::communicator();
+            l2                  = Utilities::MPI::sum(l2, comm);
+            l2_norm             = Utilities::MPI::sum(l2_norm, comm);
+            energy              = Utilities::MPI::sum(energy, comm);
+            energy_norm         = Utilities::MPI::sum(energy_norm, comm);
+            stress_error        = Utilities::MPI::max(stress_error, comm);
+            stress_max          = Utilities::MPI::max(stress_max, comm);
           }
         if (exact_displacement)
           {
@@ -295,21 +316,28 @@ namespace knee_contact
             Vector<double> exact(dim);
             for (const auto &cell : dof_handler.active_cell_iterators())
               for (const unsigned int v : cell->vertex_indices())
-                {
-                  const Point<dim> inside =
-                    cell->vertex(v) +
-                    1e-12 * (cell->center() - cell->vertex(v));
-                  exact_displacement->vector_value(inside, exact);
-                  for (unsigned int d = 0; d < dim; ++d)
-                    {
-                      nodal =
-                        std::max(nodal,
-                                 std::abs(
-                                   solution(cell->vertex_dof_index(v, d)) -
-                                   exact(d)));
-                      largest = std::max(largest, std::abs(exact(d)));
-                    }
-                }
+                if (cell->is_locally_owned())
+                  {
+                    const Point<dim> inside =
+                      cell->vertex(v) +
+                      1e-12 * (cell->center() - cell->vertex(v));
+                    exact_displacement->vector_value(inside, exact);
+                    for (unsigned int d = 0; d < dim; ++d)
+                      {
+                        nodal =
+                          std::max(nodal,
+                                   std::abs(
+                                     solution(cell->vertex_dof_index(v, d)) -
+                                     exact(d)));
+                        largest = std::max(largest, std::abs(exact(d)));
+                      }
+                  }
+            if (distributed)
+              {
+                nodal = Utilities::MPI::max(nodal, parallel::communicator());
+                largest =
+                  Utilities::MPI::max(largest, parallel::communicator());
+              }
             // Absolute where the reference is zero everywhere.
             errors.nodal_relative = nodal / (largest > 0 ? largest : 1.);
           }

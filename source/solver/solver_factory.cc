@@ -49,6 +49,30 @@ namespace knee_contact
                        : "";
     }
 
+    /**
+     * The iterative path alone (@p reason: why): its estimate @p bytes
+     * must fit in 80 % of what every rank has, or the run is refused in
+     * one line; both go to @p figures.
+     */
+    void
+    check_iterative_fits(const double                   bytes,
+                         const std::string             &reason,
+                         std::map<std::string, double> &figures)
+    {
+      std::string  limit;
+      const double available            = available_on_every_rank(limit);
+      figures["estimated_iterative_MB"] = bytes / 1048576.;
+      figures["available_MB"]           = available / 1048576.;
+      AssertThrow(bytes <= 0.8 * available,
+                  ExcMessage("out of memory: the contact solve (iterative "
+                             "path: " +
+                             reason + ") needs about " + megabytes(bytes) +
+                             " more, but " + megabytes(available) +
+                             " are available (" + limit +
+                             "); use fewer refinement cycles, a coarser "
+                             "mesh or a machine with more memory"));
+    }
+
     std::string
     gigaflops(const double flops)
     {
@@ -129,20 +153,10 @@ namespace knee_contact
     // The iterative path alone (the scene asks for it, or no factor can be
     // made): its own memory estimate must fit.
     const auto only_iterative = [&](const std::string &reason) {
-      std::string  limit;
-      const double available = available_on_every_rank(limit);
-      const double bytes =
-        IterativeContactSystem::estimated_bytes(sparsity, frictional(pairs));
-      figures["estimated_iterative_MB"] = bytes / 1048576.;
-      figures["available_MB"]           = available / 1048576.;
-      AssertThrow(bytes <= 0.8 * available,
-                  ExcMessage("out of memory: the contact solve (iterative "
-                             "path: " +
-                             reason + ") needs about " + megabytes(bytes) +
-                             " more, but " + megabytes(available) +
-                             " are available (" + limit +
-                             "); use fewer refinement cycles, a coarser "
-                             "mesh or a machine with more memory"));
+      check_iterative_fits(
+        IterativeContactSystem::estimated_bytes(sparsity, frictional(pairs)),
+        reason,
+        figures);
       return iterative(reason);
     };
     if (requested == SolverPath::iterative)
@@ -493,6 +507,58 @@ namespace knee_contact
     else
       log << on_every_rank() << std::endl;
     choice.system = std::move(sparse);
+    return choice;
+  }
+
+
+
+  SolverPlan
+  plan_contact_system(const TrilinosWrappers::SparsityPattern &pattern,
+                      const std::vector<ContactRow>           &pairs,
+                      const std::string                       &reason)
+  {
+    // No direct path is analysed: their factors and C whole would be made
+    // on a whole mesh, which a distributed run no longer has.
+    SolverPlan plan;
+    plan.figures["ranks"]            = parallel::n_ranks();
+    plan.figures["distributed_mesh"] = 1;
+    check_iterative_fits(
+      IterativeContactSystem::estimated_bytes(pattern, frictional(pairs)),
+      reason,
+      plan.figures);
+    plan.path      = SolverPath::iterative;
+    plan.reason    = reason;
+    plan.rows_only = true;
+    return plan;
+  }
+
+
+
+  SolverChoice
+  make_contact_system(SolverPlan                               &&plan,
+                      const TrilinosWrappers::SparsityPattern   &pattern,
+                      const IterativeContactSystem::RowAssembly &rows,
+                      const AffineConstraints<double>           &base,
+                      const std::vector<ContactRow>             &pairs,
+                      const RigidModeCheck                      &rigid_modes,
+                      const KrylovSettings                      &krylov,
+                      std::ostream                              &log)
+  {
+    AssertThrow(plan.path == SolverPath::iterative && plan.rows_only,
+                ExcInternalError());
+    SolverChoice choice;
+    choice.figures = std::move(plan.figures);
+    choice.name    = solver_path_name(plan.path);
+    log << "   solver: iterative (" << plan.reason << "), on the mesh "
+        << "distributed over " << parallel::n_ranks() << " ranks" << std::endl;
+    choice.system =
+      std::make_unique<IterativeContactSystem>(pattern,
+                                               rows,
+                                               base,
+                                               pairs,
+                                               rigid_modes.rigid_motions(),
+                                               rigid_modes.components(),
+                                               krylov);
     return choice;
   }
 } // namespace knee_contact

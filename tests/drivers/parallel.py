@@ -42,6 +42,7 @@ import subprocess
 import sys
 import tempfile
 
+import numpy
 import vtk
 from vtk.util.numpy_support import vtk_to_numpy
 
@@ -89,6 +90,12 @@ SCENES = [("contact_patch_3d_tet_iterative.prm", None, 2, []),
 # studies) and the 2D study on the direct path (as knee_small).
 SANITIZER_SKIPS = ("contact_patch_3d_hex.prm", "hertz_small.prm",
                    "hertz_sphere_3d_adaptive.prm", "hertz_study_small.prm")
+# The runs that take the distributed mesh (one cycle or a .geo remeshed,
+# no friction, one load case, the iterative path on several ranks:
+# ContactProblem::distribution_reason()); the others keep the whole mesh on
+# every rank. Each is asserted (summary.json's solver/distributed_mesh).
+DISTRIBUTED = ("contact_patch_3d_tet_iterative", "contact_patch_3d_hex_iterative",
+               "hertz_small_iterative", "one_cell_block")
 TOLERANCE = 1e-8
 BAR_TOLERANCE = 1e-2
 # Round-off measures and what depends on the path taken, not the answer.
@@ -180,27 +187,38 @@ def read_json(path):
         return json.load(f)
 
 
-def read_displacement(path):
-    """The point displacements of a solution.vtu."""
-    reader = vtk.vtkXMLUnstructuredGridReader()
-    reader.SetFileName(path)
-    reader.Update()
-    return vtk_to_numpy(reader.GetOutput().GetPointData().GetArray(
-        "displacement"))
-
-
-def read_cells(path):
-    """The cells of a solution.vtu (under mpirun built in pieces by every
-    rank and written by rank 0): their number, and the body and
-    coordinates of their vertices (DataOut writes each cell's own
-    vertices), in the file's order."""
+def read_points(path):
+    """The points of a solution.vtu (DataOut writes each cell's own
+    vertices), as rows of coordinates, body and displacement sorted by
+    coordinates and body: on a distributed mesh each rank writes its own
+    cells, so the file's order of cells is not the one process's."""
     reader = vtk.vtkXMLUnstructuredGridReader()
     reader.SetFileName(path)
     reader.Update()
     grid = reader.GetOutput()
-    return (grid.GetNumberOfCells(),
-            vtk_to_numpy(grid.GetPointData().GetArray("body_id")).tolist(),
-            vtk_to_numpy(grid.GetPoints().GetData()).tolist())
+    points = vtk_to_numpy(grid.GetPoints().GetData())
+    body = vtk_to_numpy(grid.GetPointData().GetArray("body_id"))
+    u = vtk_to_numpy(grid.GetPointData().GetArray("displacement"))
+    rows = numpy.column_stack([points, body, u])
+    order = numpy.lexsort([rows[:, k] for k in range(4)][::-1])
+    return rows[order]
+
+
+def read_displacement(path):
+    """The point displacements of a solution.vtu, in read_points()'s
+    order."""
+    return read_points(path)[:, 4:]
+
+
+def read_cells(path):
+    """The cells of a solution.vtu (under mpirun built in pieces by every
+    rank and written by rank 0): their number, and the coordinates and
+    bodies of their vertices in read_points()'s order."""
+    reader = vtk.vtkXMLUnstructuredGridReader()
+    reader.SetFileName(path)
+    reader.Update()
+    return (reader.GetOutput().GetNumberOfCells(),
+            read_points(path)[:, :4].tolist())
 
 
 def read_rows(path):
@@ -324,6 +342,12 @@ def compare_runs(binary, folder, name, text, ranks, failures):
             failures.append("%s/%s: solver ranks %r, not %d" %
                             (name, path, summary["solver"].get("ranks"),
                              ranks))
+        if bool(summary["solver"].get("distributed_mesh")) != \
+                (name in DISTRIBUTED):
+            failures.append("%s/%s: distributed mesh %r, expected %r" %
+                            (name, path,
+                             summary["solver"].get("distributed_mesh"),
+                             name in DISTRIBUTED))
         # The sparse path on several ranks factorises with MUMPS over all
         # of them (Contact/Direct factor = automatic).
         if summary["solver"]["name"] == "sparse" and \
@@ -341,7 +365,10 @@ def compare_runs(binary, folder, name, text, ranks, failures):
                                                 many[path], failures))
     worst = max(worst, compare_fields(name, results[0], results[ranks],
                                       failures))
-    paths = sorted({summary["solver"]["name"] for summary in many.values()})
+    paths = sorted({summary["solver"]["name"] +
+                    (" on the distributed mesh"
+                     if summary["solver"].get("distributed_mesh") else "")
+                    for summary in many.values()})
     print("%s: %d ranks (%s) against one process: largest relative "
           "difference %.1e (tolerance %.0e)" % (name, ranks, ", ".join(paths),
                                                 worst, TOLERANCE))

@@ -2,6 +2,7 @@
 #define knee_contact_problem_h
 
 #include <knee_contact/contact/contact.h>
+#include <knee_contact/mesh/distributed_mesh.h>
 #include <knee_contact/mesh/mesh.h>
 #include <knee_contact/physics/boundary_conditions.h>
 #include <knee_contact/physics/materials.h>
@@ -24,6 +25,7 @@
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/sparsity_pattern.h>
+#include <deal.II/lac/trilinos_sparsity_pattern.h>
 #include <deal.II/lac/vector.h>
 
 #include <deal.II/dofs/dof_handler.h>
@@ -211,6 +213,55 @@ namespace knee_contact
     void
     make_mesh(const int level);
 
+    /**
+     * Why this mesh (the whole one make_mesh() made) is to be distributed
+     * over the ranks, or empty where the run keeps it whole on every rank.
+     * It is distributed where the iterative path will solve on several
+     * ranks (Contact/Solver = iterative, or the automatic choice in 3D at
+     * min_distributed_dofs and more) and nothing of the run needs the
+     * whole mesh: no adaptive or refined cycles (a fully distributed mesh
+     * cannot be refined; a .geo remeshed per cycle is distributed anew),
+     * no friction, one load case.
+     */
+    std::string
+    distribution_reason(const Refinement::Strategy strategy,
+                        const unsigned int         n_cycles) const;
+
+    /**
+     * 3D meshes from this many DoFs take the distributed mesh under the
+     * automatic choice: the iterative path was measured faster than the
+     * direct ones on the 3D knee from 3.4e4 DoFs (doc/performance.md), and
+     * the Hertz sphere's condensed path, faster at 4.8e4, has a factor
+     * growing as n^(4/3) (refused on 24 GB at 6e5).
+     */
+    static constexpr double min_distributed_dofs = 2e5;
+
+    /**
+     * Divide the whole mesh make_mesh() made over the ranks
+     * (distribute_mesh()) and free it; the rest of the cycle runs on
+     * distributed->triangulation.
+     */
+    void
+    distribute();
+
+    /** The mesh the run is on: the distributed one if any, else the whole. */
+    const Triangulation<dim> &
+    mesh() const
+    {
+      return distributed ? distributed->triangulation : triangulation;
+    }
+
+    /** The cells of the mesh the run is on, over all ranks. */
+    types::global_cell_index
+    n_cells() const
+    {
+      return mesh().n_global_active_cells();
+    }
+
+    /** body_names from the whole mesh's cells and body_of_cell. */
+    void
+    name_bodies();
+
     void
     setup_system();
 
@@ -352,6 +403,13 @@ namespace knee_contact
     Refinement        refinement;
 
     Triangulation<dim> triangulation;
+    /**
+     * Where the run divides the mesh over its ranks (distribution_reason()):
+     * each rank's cells; triangulation is then empty.
+     */
+    std::unique_ptr<DistributedMesh<dim>> distributed;
+    /** Why (the solver's log line). */
+    std::string distributed_reason;
     // FE_Q(1)^dim or FE_SimplexP(1)^dim, by the mesh's cells (make_mesh).
     std::unique_ptr<FiniteElement<dim>> fe;
     DoFHandler<dim>                     dof_handler;
@@ -463,10 +521,16 @@ namespace knee_contact
     /** The bodies' rigid motions on the dofs (setup_system()). */
     std::unique_ptr<RigidModes<dim>> rigid_modes;
     SparsityPattern                  sparsity_pattern;
-    SparseMatrix<double>             system_matrix;
-    Vector<double>                   system_rhs;
-    Vector<double>                   displacement;
-    ContactSolution                  contact_solution;
+    /**
+     * On the distributed mesh: this rank's rows of every set's pattern
+     * (made there: Trilinos's empty pattern already calls MPI, which a run
+     * without mpirun, such as --print-parameters, has not started).
+     */
+    std::unique_ptr<TrilinosWrappers::SparsityPattern> distributed_pattern;
+    SparseMatrix<double>                               system_matrix;
+    Vector<double>                                     system_rhs;
+    Vector<double>                                     displacement;
+    ContactSolution                                    contact_solution;
     /** The path assemble_system() chose for the next contact system. */
     SolverPlan solver_plan;
     /** The last cycle's factorised system, kept for further load cases. */

@@ -840,6 +840,34 @@ namespace knee_contact
 
 
   /**
+   * On a distributed mesh (DistributedMesh), where each rank holds its rows
+   * of every set's condensed pattern @p pattern: the iterative path, the
+   * one that runs on it (@p reason says why it was taken), with its memory
+   * estimate (IterativeContactSystem::estimated_bytes()) checked against
+   * the least any rank has; refused in one line if it does not fit.
+   */
+  SolverPlan
+  plan_contact_system(const TrilinosWrappers::SparsityPattern &pattern,
+                      const std::vector<ContactRow>           &pairs,
+                      const std::string                       &reason);
+
+  /**
+   * The contact system of a plan for a distributed mesh: C's rows from the
+   * cells each rank owns (@p rows), on @p pattern's rows.
+   */
+  SolverChoice
+  make_contact_system(SolverPlan                               &&plan,
+                      const TrilinosWrappers::SparsityPattern   &pattern,
+                      const IterativeContactSystem::RowAssembly &rows,
+                      const AffineConstraints<double>           &base,
+                      const std::vector<ContactRow>             &pairs,
+                      const RigidModeCheck                      &rigid_modes,
+                      const KrylovSettings                      &krylov,
+                      std::ostream                              &log);
+
+
+
+  /**
    * One linear solve of C x = d with the Gamma_u/Gamma_o lines and the
    * rows of the @p active pairs as equalities, by CHOLMOD with the same
    * METIS ordering of vertices as CondensedContactSystem but no unknowns
