@@ -15,6 +15,7 @@
 #include <deal.II/lac/sparse_direct.h>
 
 #include <deal.II/dofs/dof_tools.h>
+#include <deal.II/grid/grid_generator.h>
 
 #include <nlohmann/json.hpp>
 
@@ -316,16 +317,14 @@ namespace knee_contact
 
   template <int dim>
   std::string
-  ContactProblem<dim>::distribution_reason(const Refinement::Strategy strategy,
-                                           const unsigned int n_cycles) const
+  ContactProblem<dim>::distribution_reason(
+    const Refinement::Strategy strategy) const
   {
+    // A uniform sequence makes each cycle's mesh whole anew
+    // (MeshInput::create() at the cycle's level) and distributes it.
     if (parallel::n_ranks() == 1 || strategy != Refinement::Strategy::global ||
-        (n_cycles > 1 && !mesh_input.remeshes(triangulation)) ||
-        !motions.empty() || load_cases.values().size() > 1)
+        !motions.empty())
       return "";
-    for (const auto &interface : contact_interfaces.interfaces())
-      if (interface.friction != Friction::none)
-        return "";
     const SolverPath path = active_set_solver.linear_solver();
     if (path == SolverPath::iterative)
       return "as Contact/Solver says";
@@ -348,6 +347,17 @@ namespace knee_contact
   {
     // Every rank made and checked the whole mesh (each refuses bad input
     // alike); rank 0's is divided and sent, then each frees its copy.
+    if (triangulation.n_levels() > 1)
+      {
+        // A refined mesh's description keeps its coarse cells and their
+        // refinement, whose vertices have no index of the whole mesh (the
+        // contact sides' keys): its cells become the cells of one level.
+        Triangulation<dim> flat;
+        GridGenerator::flatten_triangulation(triangulation, flat);
+        triangulation.clear();
+        triangulation.copy_triangulation(flat);
+        body_of_cell = compute_body_ids(triangulation, n_bodies);
+      }
     name_bodies();
     distributed = std::make_unique<DistributedMesh<dim>>();
     distribute_mesh(triangulation, body_of_cell, n_bodies, *distributed);

@@ -69,7 +69,7 @@ namespace knee_contact
             make_mesh(0);
           else if (strategy == Refinement::Strategy::global &&
                    (distributed || mesh_input.remeshes(triangulation)))
-            make_mesh(cycle); // a distributed mesh is one that remeshes
+            make_mesh(cycle); // a distributed mesh is made anew
           else
             {
               // A refined mesh keeps its pose; its new vertices would lie
@@ -90,7 +90,7 @@ namespace knee_contact
                                           materials,
                                           boundary_conditions);
           distributed_reason =
-            resolved ? std::string() : distribution_reason(strategy, n_cycles);
+            resolved ? std::string() : distribution_reason(strategy);
           if (!distributed_reason.empty())
             distribute();
         });

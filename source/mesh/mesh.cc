@@ -276,10 +276,12 @@ namespace knee_contact
   {
     triangulation.clear();
     // A level below 0 (the coarse start): a .geo meshed by gmsh at 2^-level
-    // times the size, other meshes -level fewer Global refinements.
+    // times the size, other meshes -level fewer Global refinements. Above 0
+    // (a uniform sequence's cycle made anew): level more refinements, or a
+    // .geo of tetrahedra meshed at 2^-level times the size (remeshes()).
     const bool geo = from_geo();
     if (source == Source::file)
-      read_file(triangulation, geo ? level : std::max(level, 0));
+      read_file(triangulation, geo ? level : 0);
     else
       make_rectangles(triangulation);
     // Tetrahedra of a .geo are refined by gmsh (see remeshes()): Global
@@ -293,6 +295,17 @@ namespace knee_contact
             read_file(triangulation, level + int(n_refinements));
           }
         n_refine = 0;
+      }
+    else if (level > 0)
+      {
+        // The scene's mesh refined level more times; a .geo of other cells
+        // than tetrahedra is read again at its own size.
+        if (geo)
+          {
+            triangulation.clear();
+            read_file(triangulation, 0);
+          }
+        n_refine = n_refinements + level;
       }
     else if (level < 0 && !geo)
       {

@@ -208,7 +208,8 @@ namespace knee_contact
 
     /**
      * The mesh at refinement @p level: 0 on the first cycle; > 0 where the
-     * mesh input remeshes instead of refining (MeshInput::remeshes()).
+     * mesh input remeshes instead of refining (MeshInput::remeshes()) or
+     * the distributed mesh of a uniform sequence is made anew.
      */
     void
     make_mesh(const int level);
@@ -218,14 +219,14 @@ namespace knee_contact
      * over the ranks, or empty where the run keeps it whole on every rank.
      * It is distributed where the iterative path will solve on several
      * ranks (Contact/Solver = iterative, or the automatic choice in 3D at
-     * min_distributed_dofs and more) and nothing of the run needs the
-     * whole mesh: no adaptive or refined cycles (a fully distributed mesh
-     * cannot be refined; a .geo remeshed per cycle is distributed anew),
-     * no friction, one load case.
+     * min_distributed_dofs and more) and the mesh is not refined in place:
+     * a uniform sequence (each cycle's mesh made whole anew, make_mesh()
+     * at its level, and distributed), no adaptive cycles (a fully
+     * distributed mesh cannot be refined) and no moved bodies (Load
+     * cases/Motion moves and turns the whole mesh).
      */
     std::string
-    distribution_reason(const Refinement::Strategy strategy,
-                        const unsigned int         n_cycles) const;
+    distribution_reason(const Refinement::Strategy strategy) const;
 
     /**
      * 3D meshes from this many DoFs take the distributed mesh under the
