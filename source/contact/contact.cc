@@ -1,4 +1,5 @@
 #include <knee_contact/base/input.h>
+#include <knee_contact/base/parallel.h>
 #include <knee_contact/contact/contact.h>
 #include <knee_contact/contact/contact_sides.h>
 #include <knee_contact/contact/face_geometry.h>
@@ -331,11 +332,15 @@ namespace knee_contact
 
       ContactSides<dim> all;
       all.min_length = std::numeric_limits<double>::max();
-      for (const auto &theirs : Utilities::MPI::all_gather(comm, mine))
+      // Each rank's block: its slaves, slave faces and master faces, each
+      // after its count.
+      const std::vector<double> theirs =
+        parallel::gather_on_every_rank(comm, mine);
+      std::size_t at = 0;
+      while (at < theirs.size())
         {
-          std::size_t at    = 0;
-          const auto  next  = [&]() { return theirs.at(at++); };
-          const auto  index = [&]() {
+          const auto next  = [&]() { return theirs.at(at++); };
+          const auto index = [&]() {
             return static_cast<types::global_dof_index>(next());
           };
           for (std::size_t n = index(); n > 0; --n)

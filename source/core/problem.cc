@@ -330,7 +330,12 @@ namespace knee_contact
       return "as Contact/Solver says";
     // The vector element's dofs: dim per vertex.
     const double n_dofs = double(dim) * triangulation.n_used_vertices();
-    if (path == SolverPath::automatic && dim == 3 &&
+    // 3D friction's Newton springs can take CG thousands of iterations
+    // (doc/friction.md): the automatic choice keeps it on a direct path.
+    bool friction = false;
+    for (const auto &interface : contact_interfaces.interfaces())
+      friction = friction || interface.friction != Friction::none;
+    if (path == SolverPath::automatic && dim == 3 && !friction &&
         n_dofs >= min_distributed_dofs)
       return "automatic: a 3D mesh of " + std::to_string(int(n_dofs)) +
              " dofs on " + std::to_string(parallel::n_ranks()) +

@@ -368,11 +368,11 @@ namespace knee_contact
         std::vector<unsigned int> mine;
         for (const auto &[a, b] : edges)
           mine.insert(mine.end(), {a, b});
-        for (const auto &part :
-             Utilities::MPI::all_gather(parallel::communicator(), mine))
-          for (std::size_t i = 0; i + 1 < part.size(); i += 2)
-            if (edges.emplace(part[i], part[i + 1]).second)
-              outline.insert({part[i], part[i + 1]});
+        const std::vector<unsigned int> all =
+          parallel::gather_on_every_rank(parallel::communicator(), mine);
+        for (std::size_t i = 0; i + 1 < all.size(); i += 2)
+          if (edges.emplace(all[i], all[i + 1]).second)
+            outline.insert({all[i], all[i + 1]});
       }
     if constexpr (dim == 2)
       {
@@ -526,10 +526,8 @@ namespace knee_contact
       {
         // The largest over the ranks (the lowest rank's where equal); the
         // recovered field's own extreme the largest of all.
-        std::vector<double> all;
-        for (const auto &part :
-             Utilities::MPI::all_gather(parallel::communicator(), found))
-          all.insert(all.end(), part.begin(), part.end());
+        const std::vector<double> all =
+          parallel::gather_on_every_rank(parallel::communicator(), found);
         std::map<std::pair<int, int>, std::vector<double>> best;
         for (std::size_t i = 0; i < all.size(); i += width)
           {

@@ -1,4 +1,5 @@
 #include <knee_contact/base/input.h>
+#include <knee_contact/base/parallel.h>
 #include <knee_contact/physics/boundary_conditions.h>
 #include <knee_contact/physics/elements.h>
 
@@ -333,20 +334,19 @@ namespace knee_contact
                 }
             }
         constraints.clear();
-        for (const auto &theirs : Utilities::MPI::all_gather(comm, mine))
-          for (std::size_t at = 0; at < theirs.size();)
-            {
-              const auto i = static_cast<types::global_dof_index>(theirs[at]);
-              constraints.add_line(i);
-              constraints.set_inhomogeneity(i, theirs[at + 1]);
-              const std::size_t n = theirs[at + 2];
-              at += 3;
-              for (std::size_t k = 0; k < n; ++k, at += 2)
-                constraints.add_entry(i,
-                                      static_cast<types::global_dof_index>(
-                                        theirs[at]),
-                                      theirs[at + 1]);
-            }
+        const std::vector<double> all =
+          parallel::gather_on_every_rank(comm, mine);
+        for (std::size_t at = 0; at < all.size();)
+          {
+            const auto i = static_cast<types::global_dof_index>(all[at]);
+            constraints.add_line(i);
+            constraints.set_inhomogeneity(i, all[at + 1]);
+            const std::size_t n = all[at + 2];
+            at += 3;
+            for (std::size_t k = 0; k < n; ++k, at += 2)
+              constraints.add_entry(
+                i, static_cast<types::global_dof_index>(all[at]), all[at + 1]);
+          }
       }
     constraints.close();
   }

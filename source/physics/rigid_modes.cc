@@ -1,3 +1,4 @@
+#include <knee_contact/base/parallel.h>
 #include <knee_contact/physics/rigid_modes.h>
 
 #include <deal.II/base/mpi.h>
@@ -82,15 +83,16 @@ namespace knee_contact
             for (unsigned int d = 0; d < dim; ++d)
               mine.push_back(dof_position[dof][d]);
           }
-        for (const auto &theirs : Utilities::MPI::all_gather(comm, mine))
-          for (std::size_t k = 0; k < theirs.size(); k += 3 + dim)
-            {
-              const auto dof     = types::global_dof_index(theirs[k]);
-              dof_body[dof]      = theirs[k + 1];
-              dof_component[dof] = theirs[k + 2];
-              for (unsigned int d = 0; d < dim; ++d)
-                dof_position[dof][d] = theirs[k + 3 + d];
-            }
+        const std::vector<double> all =
+          parallel::gather_on_every_rank(comm, mine);
+        for (std::size_t k = 0; k < all.size(); k += 3 + dim)
+          {
+            const auto dof     = types::global_dof_index(all[k]);
+            dof_body[dof]      = all[k + 1];
+            dof_component[dof] = all[k + 2];
+            for (unsigned int d = 0; d < dim; ++d)
+              dof_position[dof][d] = all[k + 3 + d];
+          }
         for (unsigned int b = 0; b < names.size(); ++b)
           for (unsigned int d = 0; d < dim; ++d)
             {

@@ -1,3 +1,4 @@
+#include <knee_contact/base/parallel.h>
 #include <knee_contact/physics/elements.h>
 #include <knee_contact/postprocess/results.h>
 
@@ -214,9 +215,9 @@ namespace knee_contact
         std::set<types::material_id> ids;
         for (const auto &[id, range] : results.stress_yy_range)
           ids.insert(id);
-        const std::vector<unsigned int> mine(ids.begin(), ids.end());
-        for (const auto &theirs : Utilities::MPI::all_gather(comm, mine))
-          ids.insert(theirs.begin(), theirs.end());
+        const std::vector<unsigned int> all = parallel::gather_on_every_rank(
+          comm, std::vector<unsigned int>(ids.begin(), ids.end()));
+        ids.insert(all.begin(), all.end());
         for (const types::material_id id : ids)
           {
             const auto found = results.stress_yy_range.find(id);

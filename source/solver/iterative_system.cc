@@ -921,42 +921,39 @@ namespace knee_contact
             mine.push_back(epetra.ColMap().GID(columns[k]));
           mine.insert(mine.end(), values, values + length);
         }
-    const std::vector<std::vector<double>> all =
-      Utilities::MPI::all_gather(parallel::communicator(), mine);
+    const std::vector<double> all =
+      parallel::gather_on_every_rank(parallel::communicator(), mine);
     mine = std::vector<double>();
+    // Each gathered row: its index, its length, its columns, its values.
+    const auto for_each_row = [&all](const auto &f) {
+      for (std::size_t k = 0; k < all.size();
+           k += 2 + 2 * std::size_t(all[k + 1]))
+        f(types::global_dof_index(all[k]),
+          static_cast<unsigned int>(all[k + 1]),
+          &all[k + 2],
+          &all[k + 2 + std::size_t(all[k + 1])]);
+    };
     std::vector<unsigned int> lengths(n, 1);
-    for (const auto &theirs : all)
-      for (std::size_t k = 0; k < theirs.size();)
-        {
-          const auto         row    = types::global_dof_index(theirs[k]);
-          const unsigned int length = theirs[k + 1];
-          lengths[row]              = std::max(1u, length);
-          k += 2 + 2 * length;
-        }
+    for_each_row([&](const auto row, const unsigned int length, auto, auto) {
+      lengths[row] = std::max(1u, length);
+    });
     line_rows_pattern.reinit(n, n, lengths);
-    for (const auto &theirs : all)
-      for (std::size_t k = 0; k < theirs.size();)
-        {
-          const auto         row    = types::global_dof_index(theirs[k]);
-          const unsigned int length = theirs[k + 1];
-          for (unsigned int c = 0; c < length; ++c)
-            line_rows_pattern.add(row,
-                                  types::global_dof_index(theirs[k + 2 + c]));
-          k += 2 + 2 * length;
-        }
+    for_each_row([&](const auto         row,
+                     const unsigned int length,
+                     const double      *columns,
+                     auto) {
+      for (unsigned int c = 0; c < length; ++c)
+        line_rows_pattern.add(row, types::global_dof_index(columns[c]));
+    });
     line_rows_pattern.compress();
     line_rows.reinit(line_rows_pattern);
-    for (const auto &theirs : all)
-      for (std::size_t k = 0; k < theirs.size();)
-        {
-          const auto         row    = types::global_dof_index(theirs[k]);
-          const unsigned int length = theirs[k + 1];
-          for (unsigned int c = 0; c < length; ++c)
-            line_rows.set(row,
-                          types::global_dof_index(theirs[k + 2 + c]),
-                          theirs[k + 2 + length + c]);
-          k += 2 + 2 * length;
-        }
+    for_each_row([&](const auto         row,
+                     const unsigned int length,
+                     const double      *columns,
+                     const double      *values) {
+      for (unsigned int c = 0; c < length; ++c)
+        line_rows.set(row, types::global_dof_index(columns[c]), values[c]);
+    });
     rows_assembly = clock.wall_time();
   }
 

@@ -1,6 +1,8 @@
 #ifndef knee_contact_parallel_h
 #define knee_contact_parallel_h
 
+#include <deal.II/base/mpi.h>
+
 #include <mpi.h>
 
 #include <functional>
@@ -94,6 +96,23 @@ namespace knee_contact
     std::vector<char>
     scatter_from_first(
       const std::function<std::vector<char>(unsigned int)> &piece_for);
+
+    /**
+     * Every rank's @p mine on every rank, one after the other in rank
+     * order (deal.II's Utilities::MPI::all_gather, concatenated): the
+     * records a rank flattened into numbers (Gamma lines, contact sides, C's
+     * line rows, the dofs' bodies and positions, the error bars' extremes),
+     * which every rank then reads whole. A collective call on @p comm.
+     */
+    template <typename T>
+    std::vector<T>
+    gather_on_every_rank(const MPI_Comm comm, const std::vector<T> &mine)
+    {
+      std::vector<T> all;
+      for (const auto &theirs : dealii::Utilities::MPI::all_gather(comm, mine))
+        all.insert(all.end(), theirs.begin(), theirs.end());
+      return all;
+    }
   } // namespace parallel
 } // namespace knee_contact
 

@@ -219,7 +219,8 @@ namespace knee_contact
      * over the ranks, or empty where the run keeps it whole on every rank.
      * It is distributed where the iterative path will solve on several
      * ranks (Contact/Solver = iterative, or the automatic choice in 3D at
-     * min_distributed_dofs and more) and the mesh is not refined in place:
+     * min_distributed_dofs and more without friction, which it keeps on a
+     * direct path) and the mesh is not refined in place:
      * a uniform sequence (each cycle's mesh made whole anew, make_mesh()
      * at its level, and distributed), no adaptive cycles (a fully
      * distributed mesh cannot be refined) and no moved bodies (Load
