@@ -86,13 +86,8 @@ main(int argc, char **argv)
   const ContactPairs<3> pairs =
     problem.contact_interfaces_of().make_pairs(dofs, lines, &mesh.vertex_id);
   say("contact rows (" + std::to_string(pairs.size()) + ")");
-  const IndexSet owned = dofs.locally_owned_dofs();
-  IndexSet       relevant;
-  DoFTools::extract_locally_relevant_dofs(dofs, relevant);
-  TrilinosWrappers::SparsityPattern pattern(owned, owned, relevant, comm);
-  DoFTools::make_sparsity_pattern(
-    dofs, pattern, AffineConstraints<double>(), false, rank);
-  pattern.compress();
+  TrilinosWrappers::SparsityPattern pattern;
+  make_distributed_pattern(dofs, pattern);
   say("pattern");
   // Every set's condensed pattern, d, the rigid motions, the iterative
   // path (C's rows assembled from the owned cells) and the scene's

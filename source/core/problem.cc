@@ -431,19 +431,9 @@ namespace knee_contact
       }
     if (distributed)
       {
-        // Each rank's rows, from its cells (the ghosts' entries go to
-        // their owners).
-        const IndexSet owned = dof_handler.locally_owned_dofs();
-        IndexSet       relevant;
-        DoFTools::extract_locally_relevant_dofs(dof_handler, relevant);
-        TrilinosWrappers::SparsityPattern mesh_pattern(
-          owned, owned, relevant, parallel::communicator());
-        DoFTools::make_sparsity_pattern(dof_handler,
-                                        mesh_pattern,
-                                        AffineConstraints<double>(),
-                                        false,
-                                        parallel::rank());
-        mesh_pattern.compress();
+        // Each rank's rows, from its cells.
+        TrilinosWrappers::SparsityPattern mesh_pattern;
+        make_distributed_pattern(dof_handler, mesh_pattern);
         distributed_pattern =
           std::make_unique<TrilinosWrappers::SparsityPattern>();
         ActiveSetSolver::make_sparsity_pattern(mesh_pattern,

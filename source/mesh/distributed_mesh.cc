@@ -3,6 +3,9 @@
 
 #include <deal.II/base/utilities.h>
 
+#include <deal.II/lac/affine_constraints.h>
+
+#include <deal.II/dofs/dof_tools.h>
 #include <deal.II/grid/grid_tools.h>
 #include <deal.II/grid/tria_description.h>
 
@@ -121,6 +124,26 @@ namespace knee_contact
 
 
 
+  template <int dim>
+  void
+  make_distributed_pattern(const DoFHandler<dim>             &dof_handler,
+                           TrilinosWrappers::SparsityPattern &pattern)
+  {
+    const MPI_Comm comm  = parallel::communicator();
+    const IndexSet owned = dof_handler.locally_owned_dofs();
+    IndexSet       relevant;
+    DoFTools::extract_locally_relevant_dofs(dof_handler, relevant);
+    pattern.reinit(owned, owned, relevant, comm);
+    DoFTools::make_sparsity_pattern(dof_handler,
+                                    pattern,
+                                    AffineConstraints<double>(),
+                                    false,
+                                    Utilities::MPI::this_mpi_process(comm));
+    pattern.compress();
+  }
+
+
+
   template struct DistributedMesh<2>;
   template struct DistributedMesh<3>;
   template void
@@ -133,4 +156,10 @@ namespace knee_contact
                   const std::vector<unsigned int> &,
                   const unsigned int,
                   DistributedMesh<3> &);
+  template void
+  make_distributed_pattern(const DoFHandler<2> &,
+                           TrilinosWrappers::SparsityPattern &);
+  template void
+  make_distributed_pattern(const DoFHandler<3> &,
+                           TrilinosWrappers::SparsityPattern &);
 } // namespace knee_contact

@@ -136,17 +136,9 @@ namespace
     distribute_mesh(whole, bodies, n_bodies, mesh);
     DoFHandler<dim> dofs(mesh.triangulation);
     dofs.distribute_dofs(whole_dofs.get_fe());
-    const IndexSet owned = dofs.locally_owned_dofs();
-    IndexSet       relevant;
-    DoFTools::extract_locally_relevant_dofs(dofs, relevant);
-
-    TrilinosWrappers::SparsityPattern pattern(owned, owned, relevant, comm);
-    DoFTools::make_sparsity_pattern(dofs,
-                                    pattern,
-                                    AffineConstraints<double>(),
-                                    false,
-                                    Utilities::MPI::this_mpi_process(comm));
-    pattern.compress();
+    const IndexSet                    owned = dofs.locally_owned_dofs();
+    TrilinosWrappers::SparsityPattern pattern;
+    make_distributed_pattern(dofs, pattern);
     TrilinosWrappers::SparseMatrix C;
     C.reinit(pattern);
     const ElasticityAssembler<dim> assembler(problem.materials_of(),

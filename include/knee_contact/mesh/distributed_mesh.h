@@ -1,7 +1,10 @@
 #ifndef knee_contact_distributed_mesh_h
 #define knee_contact_distributed_mesh_h
 
+#include <deal.II/lac/trilinos_sparsity_pattern.h>
+
 #include <deal.II/distributed/fully_distributed_tria.h>
+#include <deal.II/dofs/dof_handler.h>
 #include <deal.II/grid/tria.h>
 
 #include <vector>
@@ -60,6 +63,17 @@ namespace knee_contact
                   const std::vector<unsigned int> &whole_body_of_cell,
                   const unsigned int               n_bodies,
                   DistributedMesh<dim>            &mesh);
+
+  /**
+   * C's sparsity pattern on a distributed mesh's DoFs @p dof_handler:
+   * this rank's rows (its owned dofs, columns among its relevant ones), from
+   * the cells it owns (the entries of a ghost's rows are sent to their
+   * owners). A collective call.
+   */
+  template <int dim>
+  void
+  make_distributed_pattern(const DoFHandler<dim>             &dof_handler,
+                           TrilinosWrappers::SparsityPattern &pattern);
 } // namespace knee_contact
 
 #endif
