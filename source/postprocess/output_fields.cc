@@ -285,7 +285,7 @@ namespace knee_contact
     // number of pieces is a multiple of N, so every rank builds as many (7
     // pieces of 446 206 cells on two ranks took 5.5 s, 8 pieces 2.1 s); the
     // file is one solution.vtu, as on one process. On a distributed mesh
-    // each rank builds the pieces of its own cells, rank by rank.
+    // each rank builds the pieces of its own cells.
     const unsigned int ranks = parallel::n_ranks(), rank = parallel::rank();
     const unsigned int n_cells =
       dof_handler.get_triangulation().n_active_cells();
@@ -324,9 +324,17 @@ namespace knee_contact
           1, (own.size() + cells_per_piece - 1) / cells_per_piece);
         const std::vector<unsigned int> counts =
           Utilities::MPI::all_gather(parallel::communicator(), mine);
-        for (unsigned int r = 0; r < ranks; ++r)
-          for (unsigned int k = 0; k < counts[r]; ++k)
+        // Each rank's k-th piece, rank by rank, then the (k+1)-th: rank 0
+        // writes them in this order, so that the others build their next
+        // piece while it writes (rank by rank, a rank's second piece waited
+        // for rank 0's last: 18.6 s of VTU at 1e6 DoFs on two ranks).
+        for (unsigned int k = 0;
+             k < *std::max_element(counts.begin(), counts.end());
+             ++k)
+          for (unsigned int r = 0; r < ranks; ++r)
             {
+              if (k >= counts[r])
+                continue;
               owner.push_back(r);
               first.push_back(dof_handler.get_triangulation().end());
               end_index.push_back(0);
