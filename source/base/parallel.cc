@@ -1,6 +1,8 @@
+#include <knee_contact/base/input.h>
 #include <knee_contact/base/interruption.h>
 #include <knee_contact/base/parallel.h>
 
+#include <deal.II/base/exceptions.h>
 #include <deal.II/base/multithread_info.h>
 
 #include <dlfcn.h>
@@ -12,6 +14,8 @@
 #include <filesystem>
 #include <functional>
 #include <iostream>
+#include <sstream>
+#include <stdexcept>
 #include <streambuf>
 #include <thread>
 
@@ -66,6 +70,8 @@ namespace knee_contact
       /** Counted once at the start (a collective operation: memory checks
        * are made by one rank alone, when it writes the results). */
       unsigned int ranks_sharing_memory = 1;
+      /** On rank 0 inside on_first_rank()'s work. */
+      bool alone = false;
     } // namespace
 
 
@@ -330,6 +336,64 @@ namespace knee_contact
                  MPI_COMM_WORLD,
                  MPI_STATUS_IGNORE);
       return bytes;
+    }
+
+
+
+    std::string
+    on_first_rank(const std::function<std::string()> &work,
+                  const std::string                  &what)
+    {
+      if (n_ranks() == 1)
+        return work();
+      // Rank 0's outcome: "value\n" and the value, or the kind of its
+      // failure ("input" or "internal") and its line.
+      std::string        outcome;
+      std::exception_ptr failure;
+      if (rank() == 0)
+        {
+          alone = true;
+          try
+            {
+              outcome = "value\n" + work();
+            }
+          catch (const dealii::ExcMessage &exc)
+            {
+              std::ostringstream info;
+              exc.print_info(info);
+              outcome = "input\n" + input::one_line(info.str());
+              failure = std::current_exception();
+            }
+          catch (const std::runtime_error &exc)
+            {
+              outcome = "input\n" + input::one_line(exc.what());
+              failure = std::current_exception();
+            }
+          catch (...)
+            {
+              outcome = "internal\n";
+              failure = std::current_exception();
+            }
+          alone = false;
+        }
+      broadcast_from_first(outcome);
+      if (failure)
+        std::rethrow_exception(failure);
+      const auto        line = outcome.find('\n');
+      const std::string kind = outcome.substr(0, line);
+      if (kind == "value")
+        return outcome.substr(line + 1);
+      if (kind == "input")
+        throw std::runtime_error(outcome.substr(line + 1));
+      throw std::logic_error("rank 0 failed to " + what);
+    }
+
+
+
+    bool
+    working_alone()
+    {
+      return alone;
     }
   } // namespace parallel
 } // namespace knee_contact

@@ -8,6 +8,7 @@
 #include <knee_contact/physics/rigid_modes.h>
 
 #include <deal.II/base/data_out_base.h>
+#include <deal.II/base/mpi.h>
 #include <deal.II/base/timer.h>
 #include <deal.II/base/utilities.h>
 
@@ -31,6 +32,7 @@
 #include <map>
 #include <new>
 #include <set>
+#include <tuple>
 
 namespace knee_contact
 {
@@ -276,7 +278,7 @@ namespace knee_contact
 
   template <int dim>
   void
-  ContactProblem<dim>::make_mesh(const int level)
+  ContactProblem<dim>::release_distributed_mesh()
   {
     if (distributed)
       {
@@ -284,6 +286,15 @@ namespace knee_contact
         dof_handler.reinit(triangulation);
         distributed.reset();
       }
+  }
+
+
+
+  template <int dim>
+  void
+  ContactProblem<dim>::make_mesh(const int level)
+  {
+    release_distributed_mesh();
     mesh_input.create(triangulation, level);
     fe =
       elements::displacement_element<dim>(elements::cell_kind(triangulation));
@@ -320,23 +331,13 @@ namespace knee_contact
   ContactProblem<dim>::distribution_reason(
     const Refinement::Strategy strategy) const
   {
-    // A uniform sequence makes each cycle's mesh whole anew
-    // (MeshInput::create() at the cycle's level) and distributes it.
-    if (parallel::n_ranks() == 1 || strategy != Refinement::Strategy::global ||
-        !motions.empty())
+    if (!may_distribute(strategy))
       return "";
-    const SolverPath path = active_set_solver.linear_solver();
-    if (path == SolverPath::iterative)
+    if (active_set_solver.linear_solver() == SolverPath::iterative)
       return "as Contact/Solver says";
     // The vector element's dofs: dim per vertex.
     const double n_dofs = double(dim) * triangulation.n_used_vertices();
-    // 3D friction's Newton springs can take CG thousands of iterations
-    // (doc/friction.md): the automatic choice keeps it on a direct path.
-    bool friction = false;
-    for (const auto &interface : contact_interfaces.interfaces())
-      friction = friction || interface.friction != Friction::none;
-    if (path == SolverPath::automatic && dim == 3 && !friction &&
-        n_dofs >= min_distributed_dofs)
+    if (n_dofs >= min_distributed_dofs)
       return "automatic: a 3D mesh of " + std::to_string(int(n_dofs)) +
              " dofs on " + std::to_string(parallel::n_ranks()) +
              " ranks, at least " + std::to_string(int(min_distributed_dofs)) +
@@ -347,23 +348,94 @@ namespace knee_contact
 
 
   template <int dim>
+  bool
+  ContactProblem<dim>::may_distribute(const Refinement::Strategy strategy) const
+  {
+    // A uniform sequence makes each cycle's mesh whole anew
+    // (MeshInput::create() at the cycle's level) and distributes it.
+    if (parallel::n_ranks() == 1 || strategy != Refinement::Strategy::global ||
+        !motions.empty())
+      return false;
+    const SolverPath path = active_set_solver.linear_solver();
+    // 3D friction's Newton springs can take CG thousands of iterations
+    // (doc/friction.md): the automatic choice keeps it on a direct path.
+    bool friction = false;
+    for (const auto &interface : contact_interfaces.interfaces())
+      friction = friction || interface.friction != Friction::none;
+    return path == SolverPath::iterative ||
+           (path == SolverPath::automatic && dim == 3 && !friction);
+  }
+
+
+
+  template <int dim>
+  void
+  ContactProblem<dim>::make_distributable_mesh(
+    const int                  level,
+    const Refinement::Strategy strategy)
+  {
+    // Every rank holding the whole mesh took N times its memory on a
+    // machine (1.6 GB a rank at 1e6 dofs) and N reads of its file at once.
+    release_distributed_mesh();
+    distributed_reason = parallel::on_first_rank(
+      [&]() {
+        make_mesh(level);
+        scene_checks::check_finite_data(triangulation,
+                                        materials,
+                                        boundary_conditions);
+        return distribution_reason(strategy);
+      },
+      "make and check the mesh");
+    if (!distributed_reason.empty())
+      {
+        distribute();
+        release_scene_mesh();
+        return;
+      }
+    // Kept whole (the automatic choice, below min_distributed_dofs): made
+    // as on every rank, rank 0's anew too, since gmsh's outcome is shared
+    // by all ranks (MeshInput).
+    make_mesh(level);
+    scene_checks::check_finite_data(triangulation,
+                                    materials,
+                                    boundary_conditions);
+  }
+
+
+
+  template <int dim>
   void
   ContactProblem<dim>::distribute()
   {
-    // Every rank made and checked the whole mesh (each refuses bad input
-    // alike); rank 0's is divided and sent, then each frees its copy.
-    if (triangulation.n_levels() > 1)
+    // Rank 0 made and checked the whole mesh (make_distributable_mesh());
+    // it is divided and sent, then freed.
+    bool simplex = false;
+    if (parallel::rank() == 0)
       {
-        // A refined mesh's description keeps its coarse cells and their
-        // refinement, whose vertices have no index of the whole mesh (the
-        // contact sides' keys): its cells become the cells of one level.
-        Triangulation<dim> flat;
-        GridGenerator::flatten_triangulation(triangulation, flat);
-        triangulation.clear();
-        triangulation.copy_triangulation(flat);
-        body_of_cell = compute_body_ids(triangulation, n_bodies);
+        if (triangulation.n_levels() > 1)
+          {
+            // A refined mesh's description keeps its coarse cells and
+            // their refinement, whose vertices have no index of the whole
+            // mesh (the contact sides' keys): its cells become the cells
+            // of one level.
+            Triangulation<dim> flat;
+            GridGenerator::flatten_triangulation(triangulation, flat);
+            triangulation.clear();
+            triangulation.copy_triangulation(flat);
+            body_of_cell = compute_body_ids(triangulation, n_bodies);
+          }
+        name_bodies();
+        simplex = elements::cell_kind(triangulation).is_simplex();
       }
-    name_bodies();
+    // What the other ranks did not make (a rank without cells could not
+    // tell the cells' kind from its mesh).
+    std::tie(n_bodies, body_names, simplex) =
+      Utilities::MPI::broadcast(parallel::communicator(),
+                                std::make_tuple(n_bodies, body_names, simplex));
+    if (parallel::rank() != 0)
+      fe = elements::displacement_element<dim>(
+        simplex ? ReferenceCells::get_simplex<dim>()
+                : ReferenceCells::get_hypercube<dim>());
     distributed = std::make_unique<DistributedMesh<dim>>();
     distribute_mesh(triangulation, body_of_cell, n_bodies, *distributed);
     dof_handler.reinit(distributed->triangulation);

@@ -65,11 +65,18 @@ namespace knee_contact
           });
         bool resolved = false;
         timed("mesh", [&]() {
-          if (cycle == 0)
-            make_mesh(0);
-          else if (strategy == Refinement::Strategy::global &&
-                   (distributed || mesh_input.remeshes(triangulation)))
-            make_mesh(cycle); // a distributed mesh is made anew
+          // A mesh that may be distributed is made anew at each uniform
+          // cycle's level (a fully distributed mesh cannot be refined),
+          // by rank 0 alone.
+          if (cycle == 0 || may_distribute(strategy) ||
+              (strategy == Refinement::Strategy::global &&
+               mesh_input.remeshes(triangulation)))
+            {
+              if (may_distribute(strategy))
+                make_distributable_mesh(cycle, strategy);
+              else
+                make_mesh(cycle);
+            }
           else
             {
               // A refined mesh keeps its pose; its new vertices would lie
@@ -86,13 +93,14 @@ namespace knee_contact
                                             goal_indicator());
               check_cells(triangulation);
             }
-          scene_checks::check_finite_data(triangulation,
-                                          materials,
-                                          boundary_conditions);
-          distributed_reason =
-            resolved ? std::string() : distribution_reason(strategy);
-          if (!distributed_reason.empty())
-            distribute();
+          // make_distributable_mesh() checked and decided.
+          if (!may_distribute(strategy))
+            {
+              scene_checks::check_finite_data(triangulation,
+                                              materials,
+                                              boundary_conditions);
+              distributed_reason.clear();
+            }
         });
         if (resolved)
           {

@@ -123,7 +123,9 @@ namespace knee_contact
      * gmsh made, written into a folder of their own (no file system shared
      * between the ranks' machines is assumed). Every rank running gmsh took
      * N gmsh processes, each allowed a quarter of the machine's memory, and
-     * N times gmsh's time where ranks outnumber cores.
+     * N times gmsh's time where ranks outnumber cores. Inside
+     * parallel::on_first_rank()'s work (rank 0 making a mesh alone, to be
+     * distributed) rank 0 checks here, alone.
      */
     std::unique_ptr<CheckedMsh>
     checked_msh(const std::string              &file,
@@ -132,47 +134,29 @@ namespace knee_contact
     {
       if (kept_msh && kept_msh->file == file &&
           kept_msh->arguments == arguments)
-        return std::move(kept_msh);
-      if (parallel::n_ranks() == 1)
+        {
+          if (!parallel::working_alone())
+            return std::move(kept_msh);
+          // Rank 0 alone reads it but keeps it, as every other rank keeps
+          // its copy: a mesh then kept whole is made on every rank alike.
+          auto view       = std::make_unique<CheckedMsh>();
+          view->file      = kept_msh->file;
+          view->arguments = kept_msh->arguments;
+          view->msh       = kept_msh->msh;
+          view->dim       = kept_msh->dim;
+          return view;
+        }
+      if (parallel::n_ranks() == 1 || parallel::working_alone())
         return check_here(file, arguments, limits);
 
-      // Rank 0's outcome: empty, or the kind of its failure and its line.
+      // Rank 0's outcome: its failure on every rank, or its checked file.
       std::unique_ptr<CheckedMsh> result;
-      std::exception_ptr          failure;
-      std::string                 outcome;
-      if (parallel::rank() == 0)
-        try
-          {
-            result = check_here(file, arguments, limits);
-          }
-        catch (const ExcMessage &exc)
-          {
-            std::ostringstream info;
-            exc.print_info(info);
-            outcome = "input\n" + input::one_line(info.str());
-            failure = std::current_exception();
-          }
-        catch (const std::runtime_error &exc)
-          {
-            outcome = "input\n" + input::one_line(exc.what());
-            failure = std::current_exception();
-          }
-        catch (...)
-          {
-            outcome = "internal\n";
-            failure = std::current_exception();
-          }
-      parallel::broadcast_from_first(outcome);
-      if (failure)
-        std::rethrow_exception(failure);
-      if (!outcome.empty())
-        {
-          const auto line = outcome.find('\n');
-          if (outcome.substr(0, line) == "input")
-            throw std::runtime_error(outcome.substr(line + 1));
-          throw std::logic_error("rank 0 failed to mesh or check '" + file +
-                                 "'");
-        }
+      parallel::on_first_rank(
+        [&]() {
+          result = check_here(file, arguments, limits);
+          return std::string();
+        },
+        "mesh or check '" + file + "'");
 
       // The dimension, and the mesh gmsh made (empty: the user's file).
       std::string dim, made;
@@ -233,6 +217,14 @@ namespace knee_contact
       return mesh_readers::abaqus_dimension(file);
     kept_msh = checked_msh(file, arguments, limits);
     return kept_msh->dim;
+  }
+
+
+
+  void
+  release_scene_mesh()
+  {
+    kept_msh.reset();
   }
 
 

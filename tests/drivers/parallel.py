@@ -28,7 +28,9 @@
    sparse path's MUMPS (ranks that own no row still take part in every
    collective operation).
 3. Bad input under mpirun: exit code 1 and the one-line error printed once
-   (not once per rank); also a .geo gmsh refuses (rank 0 alone runs gmsh,
+   (not once per rank); a mesh refused where it may be distributed (rank
+   0 alone makes and checks it, the other takes its refusal), as one
+   process refuses it; also a .geo gmsh refuses (rank 0 alone runs gmsh,
    the others take its failure).
 Under the sanitizers (SANITIZE = ON) the scenes whose code under mpirun is
 that of another scene here are left out (SANITIZER_SKIPS): each run there
@@ -82,6 +84,14 @@ SCENES = [("contact_patch_3d_tet_iterative.prm", None, 2, []),
           # second made whole anew, one more refinement, and distributed):
           # the last mesh's results and the sequence's error bars.
           ("hertz_small.prm", "iterative", 2,
+           [(r"\nsubsection Contact\n",
+             "\nsubsection Refinement\n  set Number of cycles = 2\nend\n"
+             "subsection Contact\n")]),
+          # The automatic choice on a small 3D mesh, a uniform sequence of
+          # two: rank 0 alone makes each cycle's mesh and decides, then,
+          # below ContactProblem::min_distributed_dofs, every rank makes it
+          # whole.
+          ("contact_patch_3d_hex.prm", None, 2,
            [(r"\nsubsection Contact\n",
              "\nsubsection Refinement\n  set Number of cycles = 2\nend\n"
              "subsection Contact\n")]),
@@ -477,6 +487,27 @@ def main():
         if result.returncode != 1 or len(said) != 1 or "Young" not in said[0]:
             failures.append("bad input on 2 ranks: exit code %d, error "
                             "lines %s" % (result.returncode, said))
+
+        # A mesh refused where it may be distributed (the iterative path
+        # on 2 ranks): rank 0 alone makes and checks it, the other takes
+        # its refusal; said once, the same exit code as one process.
+        same_body = os.path.join(folder, "same_body.prm")
+        with open(same_body, "w") as f:
+            f.write(BLOCK.replace("Slave boundary id  = 5",
+                                  "Slave boundary id  = 1")
+                    .replace("@FOLDER@", os.path.join(folder, "same")))
+        alone = run(binary, same_body, 0)
+        result = run(binary, same_body, 2)
+        said = [line for line in result.stderr.splitlines()
+                if line.startswith("knee_contact: error:")]
+        print("a refused mesh on 2 ranks: exit code %d (one process %d), "
+              "%d error line(s): %s" %
+              (result.returncode, alone.returncode, len(said), said))
+        if result.returncode != alone.returncode or len(said) != 1 or \
+                "both lie on body" not in said[0] or \
+                said[0] not in alone.stderr:
+            failures.append("a refused mesh on 2 ranks: exit code %d, "
+                            "error lines %s" % (result.returncode, said))
 
         # A .geo gmsh refuses: rank 0 alone meshes, the others take its
         # failure; said once, the same exit code.

@@ -98,6 +98,26 @@ namespace knee_contact
       const std::function<std::vector<char>(unsigned int)> &piece_for);
 
     /**
+     * @p work done by rank 0 alone while the others wait asleep (as in
+     * broadcast_from_first()), and its outcome on every rank: the string
+     * it returned, or its failure thrown on every rank, so that a refusal
+     * ends every rank alike and is printed once (rank 0 rethrows its own
+     * exception; the others a std::runtime_error with its one line where
+     * it was bad input, an ExcMessage or a std::runtime_error, else a
+     * std::logic_error "rank 0 failed to @p what"). While @p work runs,
+     * working_alone() is true on rank 0. One rank: @p work, as it is.
+     */
+    std::string
+    on_first_rank(const std::function<std::string()> &work,
+                  const std::string                  &what);
+    /**
+     * Whether this rank is inside on_first_rank()'s work: a step that
+     * would share its work with the other ranks (gmsh's outcome, say)
+     * does it here alone instead, since they are not there to take part.
+     */
+    bool
+    working_alone();
+    /**
      * Every rank's @p mine on every rank, one after the other in rank
      * order (deal.II's Utilities::MPI::all_gather, concatenated): the
      * records a rank flattened into numbers (Gamma lines, contact sides, C's

@@ -230,6 +230,32 @@ namespace knee_contact
     distribution_reason(const Refinement::Strategy strategy) const;
 
     /**
+     * Whether the scene alone (before its mesh is made) lets the run
+     * distribute its mesh: distribution_reason() without the automatic
+     * choice's count of DoFs.
+     */
+    bool
+    may_distribute(const Refinement::Strategy strategy) const;
+
+    /**
+     * The mesh of a cycle at @p level where it may be distributed
+     * (may_distribute()): rank 0 alone makes and checks it whole
+     * (make_mesh()) and decides (distribution_reason()) while the others
+     * wait asleep; they take its refusal (said once) or its decision. A
+     * mesh to distribute is divided from rank 0's (distribute()), so that
+     * no other rank ever holds the whole mesh; one the automatic choice
+     * keeps whole (below min_distributed_dofs) is made on every rank as
+     * make_mesh() does.
+     */
+    void
+    make_distributable_mesh(const int                  level,
+                            const Refinement::Strategy strategy);
+
+    /** The distributed mesh, if any, let go of (every rank). */
+    void
+    release_distributed_mesh();
+
+    /**
      * 3D meshes from this many DoFs take the distributed mesh under the
      * automatic choice: the iterative path was measured faster than the
      * direct ones on the 3D knee from 3.4e4 DoFs (doc/performance.md), and
@@ -239,9 +265,10 @@ namespace knee_contact
     static constexpr double min_distributed_dofs = 2e5;
 
     /**
-     * Divide the whole mesh make_mesh() made over the ranks
+     * Divide the whole mesh rank 0's make_mesh() made over the ranks
      * (distribute_mesh()) and free it; the rest of the cycle runs on
-     * distributed->triangulation.
+     * distributed->triangulation. The other ranks take what they did not
+     * make from rank 0: the bodies, their names and the cells' kind.
      */
     void
     distribute();

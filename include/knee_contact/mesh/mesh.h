@@ -38,6 +38,14 @@ namespace knee_contact
   scene_dimension(const MeshInput<2> &mesh_input,
                   const std::string  &scene_file);
 
+  /**
+   * The mesh scene_dimension() kept, let go (its temporary file removed)
+   * where no rank will read it again: a run on the distributed mesh, whose
+   * rank 0 read it alone.
+   */
+  void
+  release_scene_mesh();
+
 
 
   /**
