@@ -27,11 +27,12 @@
    on a base of 4 x 2 (19 vertices), 24 ranks, the iterative path and the
    sparse path's MUMPS (ranks that own no row still take part in every
    collective operation).
-3. Bad input under mpirun: exit code 1 and the one-line error printed once
-   (not once per rank); a mesh refused where it may be distributed (rank
-   0 alone makes and checks it, the other takes its refusal), as one
-   process refuses it; also a .geo gmsh refuses (rank 0 alone runs gmsh,
-   the others take its failure).
+3. Bad input under mpirun, refused as one process refuses it: exit code
+   1 and the one process's one-line error, printed once (not once per
+   rank): a bad parameter, a mesh refused where it may be distributed
+   (rank 0 alone makes and checks it, the other takes its refusal) and a
+   .geo gmsh refuses (rank 0 alone runs gmsh, the others take its
+   failure).
 Under the sanitizers (SANITIZE = ON) the scenes whose code under mpirun is
 that of another scene here are left out (SANITIZER_SKIPS): each run there
 is 3 to 7 times slower, and the adaptive Hertz sphere alone took 200 s.
@@ -441,6 +442,25 @@ end
 """ % friction.MATERIALS
 
 
+def refused_once(binary, folder, name, text, expected, failures):
+    """The scene @p text refused on 2 ranks as by one process: exit code 1,
+    one error line printed once, holding @p expected, the one process's
+    line."""
+    scene = os.path.join(folder, re.sub(r"\W+", "_", name) + ".prm")
+    with open(scene, "w") as f:
+        f.write(text)
+    alone = run(binary, scene, 0)
+    result = run(binary, scene, 2)
+    said = [line for line in result.stderr.splitlines()
+            if line.startswith("knee_contact: error:")]
+    print("%s on 2 ranks: exit code %d (one process %d), %d error line(s): "
+          "%s" % (name, result.returncode, alone.returncode, len(said), said))
+    if result.returncode != 1 or alone.returncode != 1 or len(said) != 1 or \
+            expected not in said[0] or said[0] not in alone.stderr:
+        failures.append("%s on 2 ranks: exit code %d, error lines %s" %
+                        (name, result.returncode, said))
+
+
 def main():
     binary = os.path.abspath(sys.argv[1])
     sanitize = len(sys.argv) > 2 and sys.argv[2] == "ON"
@@ -474,43 +494,23 @@ def main():
             compare_runs(binary, folder, "motion_drag_3d", drag, 2, failures)
 
         # Bad input: refused by every rank, said once.
-        bad = os.path.join(folder, "bad.prm")
-        with open(bad, "w") as f:
-            f.write(BLOCK.replace("set Young's modulus = 3e9",
-                                  "set Young's modulus = -3e9")
-                    .replace("@FOLDER@", os.path.join(folder, "bad")))
-        result = run(binary, bad, 2)
-        said = [line for line in result.stderr.splitlines()
-                if line.startswith("knee_contact: error:")]
-        print("bad input on 2 ranks: exit code %d, %d error line(s): %s" %
-              (result.returncode, len(said), said))
-        if result.returncode != 1 or len(said) != 1 or "Young" not in said[0]:
-            failures.append("bad input on 2 ranks: exit code %d, error "
-                            "lines %s" % (result.returncode, said))
+        refused_once(binary, folder, "bad input",
+                     BLOCK.replace("set Young's modulus = 3e9",
+                                   "set Young's modulus = -3e9")
+                     .replace("@FOLDER@", os.path.join(folder, "bad")),
+                     "Young", failures)
 
         # A mesh refused where it may be distributed (the iterative path
         # on 2 ranks): rank 0 alone makes and checks it, the other takes
-        # its refusal; said once, the same exit code as one process.
-        same_body = os.path.join(folder, "same_body.prm")
-        with open(same_body, "w") as f:
-            f.write(BLOCK.replace("Slave boundary id  = 5",
-                                  "Slave boundary id  = 1")
-                    .replace("@FOLDER@", os.path.join(folder, "same")))
-        alone = run(binary, same_body, 0)
-        result = run(binary, same_body, 2)
-        said = [line for line in result.stderr.splitlines()
-                if line.startswith("knee_contact: error:")]
-        print("a refused mesh on 2 ranks: exit code %d (one process %d), "
-              "%d error line(s): %s" %
-              (result.returncode, alone.returncode, len(said), said))
-        if result.returncode != alone.returncode or len(said) != 1 or \
-                "both lie on body" not in said[0] or \
-                said[0] not in alone.stderr:
-            failures.append("a refused mesh on 2 ranks: exit code %d, "
-                            "error lines %s" % (result.returncode, said))
+        # its refusal.
+        refused_once(binary, folder, "a refused mesh",
+                     BLOCK.replace("Slave boundary id  = 5",
+                                   "Slave boundary id  = 1")
+                     .replace("@FOLDER@", os.path.join(folder, "same")),
+                     "both lie on body", failures)
 
         # A .geo gmsh refuses: rank 0 alone meshes, the others take its
-        # failure; said once, the same exit code.
+        # failure.
         geo = os.path.join(folder, "broken.geo")
         with open(geo, "w") as f:
             f.write("Point(1) = {0, 0, 0, 1};\nLine(1) = {1, 2};\n")
@@ -520,18 +520,8 @@ def main():
         text = re.sub(r"set File\s*=.*", "set File = " + geo, text)
         text = re.sub(r"set Folder\s*=.*",
                       "set Folder = " + os.path.join(folder, "geo"), text)
-        broken = os.path.join(folder, "broken.prm")
-        with open(broken, "w") as f:
-            f.write(text)
-        result = run(binary, broken, 2)
-        said = [line for line in result.stderr.splitlines()
-                if line.startswith("knee_contact: error:")]
-        print("broken .geo on 2 ranks: exit code %d, %d error line(s): %s" %
-              (result.returncode, len(said), said))
-        if result.returncode != 1 or len(said) != 1 or \
-                "gmsh failed" not in said[0]:
-            failures.append("broken .geo on 2 ranks: exit code %d, error "
-                            "lines %s" % (result.returncode, said))
+        refused_once(binary, folder, "broken .geo", text, "gmsh failed",
+                     failures)
     for failure in failures:
         print("FAIL " + failure)
     sys.exit(1 if failures else 0)
