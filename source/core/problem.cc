@@ -376,13 +376,16 @@ namespace knee_contact
   {
     // Every rank holding the whole mesh took N times its memory on a
     // machine (1.6 GB a rank at 1e6 dofs) and N reads of its file at once.
+    const auto make_checked_mesh = [&]() {
+      make_mesh(level);
+      scene_checks::check_finite_data(triangulation,
+                                      materials,
+                                      boundary_conditions);
+    };
     release_distributed_mesh();
     distributed_reason = parallel::on_first_rank(
       [&]() {
-        make_mesh(level);
-        scene_checks::check_finite_data(triangulation,
-                                        materials,
-                                        boundary_conditions);
+        make_checked_mesh();
         return distribution_reason(strategy);
       },
       "make and check the mesh");
@@ -395,10 +398,7 @@ namespace knee_contact
     // Kept whole (the automatic choice, below min_distributed_dofs): made
     // as on every rank, rank 0's anew too, since gmsh's outcome is shared
     // by all ranks (MeshInput).
-    make_mesh(level);
-    scene_checks::check_finite_data(triangulation,
-                                    materials,
-                                    boundary_conditions);
+    make_checked_mesh();
   }
 
 

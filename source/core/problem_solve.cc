@@ -68,11 +68,12 @@ namespace knee_contact
           // A mesh that may be distributed is made anew at each uniform
           // cycle's level (a fully distributed mesh cannot be refined),
           // by rank 0 alone.
-          if (cycle == 0 || may_distribute(strategy) ||
+          const bool distributable = may_distribute(strategy);
+          if (cycle == 0 || distributable ||
               (strategy == Refinement::Strategy::global &&
                mesh_input.remeshes(triangulation)))
             {
-              if (may_distribute(strategy))
+              if (distributable)
                 make_distributable_mesh(cycle, strategy);
               else
                 make_mesh(cycle);
@@ -94,7 +95,7 @@ namespace knee_contact
               check_cells(triangulation);
             }
           // make_distributable_mesh() checked and decided.
-          if (!may_distribute(strategy))
+          if (!distributable)
             {
               scene_checks::check_finite_data(triangulation,
                                               materials,
