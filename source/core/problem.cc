@@ -291,6 +291,18 @@ namespace knee_contact
 
 
   template <int dim>
+  std::map<std::string, double>
+  ContactProblem<dim>::phase_times(const TimerOutput &timer) const
+  {
+    auto times = timer.get_summary_data(TimerOutput::total_wall_time);
+    for (const auto &[step, seconds] : mesh_times)
+      times["mesh: " + step] = seconds;
+    return times;
+  }
+
+
+
+  template <int dim>
   void
   ContactProblem<dim>::make_mesh(const int level)
   {
@@ -383,16 +395,20 @@ namespace knee_contact
                                       boundary_conditions);
     };
     release_distributed_mesh();
+    Timer clock;
     distributed_reason = parallel::on_first_rank(
       [&]() {
         make_checked_mesh();
         return distribution_reason(strategy);
       },
       "make and check the mesh");
+    mesh_times["read"] += clock.wall_time();
     if (!distributed_reason.empty())
       {
         distribute();
         release_scene_mesh();
+        for (const auto &[step, seconds] : distributed->times)
+          mesh_times[step] += seconds;
         return;
       }
     // Kept whole (the automatic choice, below min_distributed_dofs): made
@@ -608,8 +624,7 @@ namespace knee_contact
     else if (output_writer.takes_part())
       write_result_set(results, sequences, timer);
 
-    const auto wall_times =
-      timer.get_summary_data(TimerOutput::total_wall_time);
+    const auto wall_times = phase_times(timer);
     output_writer.commit();
     if (!output_writer.test_mode())
       {

@@ -106,8 +106,7 @@ namespace knee_contact
       output_writer.write_summary(results,
                                   contact_solution,
                                   materials,
-                                  timer.get_summary_data(
-                                    TimerOutput::total_wall_time),
+                                  phase_times(timer),
                                   solver_name,
                                   solver_figures,
                                   error_estimates);

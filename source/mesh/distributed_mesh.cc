@@ -1,6 +1,7 @@
 #include <knee_contact/base/parallel.h>
 #include <knee_contact/mesh/distributed_mesh.h>
 
+#include <deal.II/base/timer.h>
 #include <deal.II/base/utilities.h>
 
 #include <deal.II/lac/affine_constraints.h>
@@ -48,6 +49,7 @@ namespace knee_contact
     // its descriptions; what is written here is only which rank gets which
     // and the bodies, which deal.II's description does not carry.
     std::vector<unsigned int> body_of_coarse;
+    Timer                     clock;
     if (Utilities::MPI::this_mpi_process(comm) == 0)
       {
         GridTools::partition_triangulation(ranks, whole);
@@ -62,7 +64,9 @@ namespace knee_contact
             body_of_coarse[coarse->index()] =
               whole_body_of_cell.at(cell->active_cell_index());
           }
+        mesh.times["partition"] = clock.wall_time();
       }
+    clock.restart();
     std::vector<char> bytes =
       parallel::scatter_from_first([&](const unsigned int r) {
         MeshPart<dim> part;
@@ -90,6 +94,9 @@ namespace knee_contact
           }
         return Utilities::pack(part, false);
       });
+    // On the other ranks: waiting for its description.
+    mesh.times["descriptions"] = clock.wall_time();
+    clock.restart();
     MeshPart<dim> part = Utilities::unpack<MeshPart<dim>>(bytes, false);
     std::vector<char>().swap(bytes);
     const auto &[description, bodies, vertex_ids] = part;
@@ -120,6 +127,7 @@ namespace knee_contact
                     ExcInternalError());
         mesh.vertex_id[v] = vertex_ids[v];
       }
+    mesh.times["part"] = clock.wall_time();
   }
 
 

@@ -255,6 +255,11 @@ namespace knee_contact
     void
     release_distributed_mesh();
 
+    /** The run's phases from @p timer and the mesh phase's steps
+     * (mesh_times, as "mesh: <step>") [s]. */
+    std::map<std::string, double>
+    phase_times(const TimerOutput &timer) const;
+
     /**
      * 3D meshes from this many DoFs take the distributed mesh under the
      * automatic choice: the iterative path was measured faster than the
@@ -439,6 +444,13 @@ namespace knee_contact
     std::unique_ptr<DistributedMesh<dim>> distributed;
     /** Why (the solver's log line). */
     std::string distributed_reason;
+    /**
+     * The mesh phase's steps on this rank where the mesh may be distributed
+     * [s, summed over the cycles]: "read" (rank 0 alone makes and checks
+     * the whole mesh) and distribute_mesh()'s steps; summary.json's
+     * wall_time as "mesh: <step>" (the scaling model's serial terms).
+     */
+    std::map<std::string, double> mesh_times;
     // FE_Q(1)^dim or FE_SimplexP(1)^dim, by the mesh's cells (make_mesh).
     std::unique_ptr<FiniteElement<dim>> fe;
     DoFHandler<dim>                     dof_handler;

@@ -7,6 +7,8 @@
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/grid/tria.h>
 
+#include <map>
+#include <string>
 #include <vector>
 
 namespace knee_contact
@@ -44,6 +46,13 @@ namespace knee_contact
      * keys); invalid for a vertex a refinement of the whole mesh made.
      */
     std::vector<unsigned int> vertex_id;
+    /**
+     * What distribute_mesh() took on this rank [s]: "partition" and
+     * "descriptions" (rank 0 alone: METIS, and making, packing and
+     * sending every rank's description, while the others wait for theirs),
+     * "part" (each rank making its cells from its description).
+     */
+    std::map<std::string, double> times;
   };
 
   /**
