@@ -150,6 +150,16 @@ def main():
             "output": statistics.median(
                 rank_zero_alone(summary, seconds) for summary, seconds in runs),
             "pairs": summaries[0].get("n_contact_pairs", 0),
+            "distributed": summaries[0]["solver"].get("distributed_mesh", 0),
+            "mesh": median(lambda s: s["wall_time"].get("mesh", 0)),
+            "read": median(lambda s: s["wall_time"].get("mesh: read", 0)),
+            "partition": median(
+                lambda s: s["wall_time"].get("mesh: partition", 0)),
+            "descriptions": median(
+                lambda s: s["wall_time"].get("mesh: descriptions", 0)),
+            "part": median(lambda s: s["wall_time"].get("mesh: part", 0)),
+            "mesh_peak": median(
+                lambda s: s["solver"].get("mesh_peak_memory_MB", 0)),
             "difference": difference})
 
     print("| ranks | DoFs | path | whole run [s] | solve [s] | Krylov [s] "
@@ -167,6 +177,11 @@ def main():
                   base["solve"] / max(row["solve"], 1e-9), row["estimate"],
                   row["path_measured"], row["peak"], row["difference"]))
     if args.model:
+        # The program's own memory (its libraries): a scene of a few cells.
+        tiny, _ = run(binary, scene_text(os.path.join(
+            os.path.dirname(os.path.abspath(__file__)), "..", "tests",
+            "scenes", "contact_patch_3d_hex.prm"), None),
+            os.path.abspath(os.path.join("output", "scaling", "base")), 1)
         small = None
         if args.small:
             folder = os.path.abspath(
@@ -175,15 +190,18 @@ def main():
                              folder, 1)
             small = {"dofs": summary["n_dofs"],
                      "cg": summary["solver"].get("krylov_iterations", 0)}
-        print_model(rows, small)
+        print_model(rows, small, tiny["solver"].get("peak_memory_MB", 0))
 
 
-def print_model(rows, small):
+def print_model(rows, small, base):
     """The model fitted to N = 1, 2 beside every measured N, and its
     extrapolation (scaling_model.py)."""
     by_ranks = {row["ranks"]: row for row in rows}
     if 1 not in by_ranks or 2 not in by_ranks:
         sys.exit("--model needs runs on 1 and 2 ranks")
+    if by_ranks[2]["distributed"]:
+        print_distributed_model(by_ranks, small, base)
+        return
     model = scaling_model.fit(by_ranks[1], by_ranks[2])
     cores = os.cpu_count()
     print("\nModel (scripts/scaling_model.py) fitted to N = 1, 2 on %d cores:"
@@ -222,6 +240,52 @@ def print_model(rows, small):
                 dofs, ranks, e["cg"], e["stage"]["run"],
                 e["stage"]["memory"] / 1024, e["distributed"]["run"],
                 e["distributed"]["memory"] / 1024))
+
+
+def print_distributed_model(by_ranks, small, base):
+    """print_model() for runs on the distributed mesh; @p base the peak
+    memory of a scene of a few cells [MB]."""
+    model = scaling_model.fit_distributed(by_ranks[1], by_ranks[2], base)
+    cores = os.cpu_count()
+    print("\nModel of the distributed mesh (scripts/scaling_model.py) fitted "
+          "to N = 1, 2 on %d cores:" % cores)
+    print(", ".join("%s %.4g" % (k, v) for k, v in model.items()))
+    print("\n| ranks | run measured [s] | model [s] | model with measured "
+          "CG it. [s] | error | mesh meas. / model [s] | of which rank 0's "
+          "descriptions meas. / model [s] | D meas. / model [s] "
+          "| K meas. / model [s] | rank 0's memory meas. / model [MB] |")
+    print("|" + "---|" * 10)
+    for ranks, row in sorted(by_ranks.items()):
+        assumed = scaling_model.predict_distributed(model, ranks, cores)
+        with_cg = scaling_model.predict_distributed(model, ranks, cores,
+                                                    iterations=row["cg"])
+        print("| %d | %.1f | %.1f | %.1f | %+.0f %% | %.1f / %.1f "
+              "| %.1f / %.1f | %.1f / %.1f | %.1f / %.1f | %.0f / %.0f |" % (
+                  ranks, row["run"], assumed["run"], with_cg["run"],
+                  100 * (assumed["run"] / row["run"] - 1), row["mesh"],
+                  assumed["mesh"], row["descriptions"], assumed["Q"],
+                  scaling_model.divided(row), assumed["D"], row["krylov"],
+                  assumed["K"], row["peak"], assumed["memory"]))
+    alpha = 0.0
+    if small:
+        alpha = scaling_model.iteration_exponent(small, by_ranks[1])
+        print("\nCG iterations %d at %d DoFs, %d at %d: alpha %.2f" % (
+            small["cg"], small["dofs"], by_ranks[1]["cg"],
+            by_ranks[1]["dofs"], alpha))
+    print("\nExtrapolated (network assumed: %s; one rank per core):" %
+          scaling_model.ASSUMED_NETWORK)
+    print("\n| DoFs | ranks | CG it. | as now: run [s] (rank 0's serial "
+          "part) / rank 0's memory [GB] | the mesh read in parts: run [s] / "
+          "memory per rank [GB] |")
+    print("|---|---|---|---|---|")
+    for dofs in (1e7, 1e8):
+        for ranks in (16, 64, 256):
+            e = scaling_model.extrapolate_distributed(
+                model, alpha, dofs, ranks, 2 * by_ranks[1]["pairs"])
+            print("| %.0e | %d | %.0f | %.0f (%.0f) / %.1f | %.0f / %.2f |" % (
+                dofs, ranks, e["cg"], e["now"]["run"], e["now"]["serial"],
+                e["now"]["memory"] / 1024, e["parts"]["run"],
+                e["parts"]["memory"] / 1024))
 
 
 if __name__ == "__main__":

@@ -34,6 +34,29 @@ Memory per rank: the replicated part (the peak of one rank less its
 iterative path) plus the path's replicated vectors and its divided matrix
 and hierarchy, P(N) = Pr + Pd / N (Pr, Pd from N = 1, 2).
 
+On the distributed mesh (a run whose summary.json says
+solver/distributed_mesh = 1: the iterative path over several ranks, a
+uniform sequence) every rank works on its own cells and the run splits
+into (fit_distributed(), predict_distributed(); rank 0's times):
+
+  G  rank 0 alone makes and checks the whole mesh (summary's "mesh: read";
+     one process's whole mesh phase): serial, G(N) = G1,
+  P  rank 0's METIS partition ("mesh: partition"): P(N) = P2,
+  Q  rank 0 makes and sends each rank's description ("mesh: descriptions"),
+     each a pass over the whole mesh: Q(N) = N q, q = Q2 / 2,
+  H  a rank makes its cells from its description ("mesh: part"):
+     H(N) = 2 H2 / min(N, C) (ranks sharing a core take turns),
+  D  the rest of the timed work, on each rank's cells (setup, assembly,
+     the active-set loop's condensation and decisions, postprocess, error
+     estimate): D(N) = D1 beta_D / min(N, C), beta_D = 2 D(2) / D1,
+  K, A, W as above,
+  memory of rank 0 = max(M_mesh, Mr + Md / N): M_mesh its peak while it
+     holds the whole mesh and a description (summary's
+     solver/mesh_peak_memory_MB at N = 2, taken constant in N), Mr, Md
+     from the peaks at N = 1, 2. Of each, M0 (the program and its
+     libraries: the peak of a scene of a few cells) does not grow with the
+     DoFs, the rest grows as n in the extrapolation.
+
 For 1e7 and 1e8 DoFs on 16-256 ranks (no cluster is reachable here) the
 same costs per DoF are extrapolated twice: for this stage (the mesh, the
 stiffness matrix and the replicated work on every rank) and for the
@@ -161,3 +184,113 @@ def extrapolate(model, alpha, dofs, ranks, contact_faces_ref,
         faces * FACE_BYTES / 2**20,
     }
     return {"stage": stage, "distributed": distributed, "cg": cg}
+
+
+def divided(run):
+    """D of a run on the distributed mesh: its timed work on its own cells
+    (the run less the mesh phase, the Krylov iterations, the AMG set-up
+    and rank 0's work alone)."""
+    return run["run"] - run["mesh"] - run["krylov"] - run["amg"] - \
+        run["output"]
+
+
+def fit_distributed(one, two, base=0.0):
+    """The distributed mesh's constants from one process and two ranks;
+    @p base the peak [MB] of a scene of a few cells (M0)."""
+    k1 = one["krylov"] / one["cg"]
+    divided_memory = 2 * (one["peak"] - two["peak"])
+    return {
+        "G1": one["mesh"],
+        "P2": two["partition"],
+        "q": two["descriptions"] / 2,
+        "H1": 2 * two["part"],
+        "D1": divided(one),
+        "beta_D": 2 * divided(two) / divided(one),
+        "k1": k1,
+        "c2": two["krylov"] / two["cg"] - k1 / 2,
+        "A1": one["amg"],
+        "a2": two["amg"] - one["amg"] / 2,
+        "W1": one["output"],
+        "I1": one["cg"],
+        "M_mesh": two["mesh_peak"],
+        "M_replicated": one["peak"] - divided_memory,
+        "M_divided": divided_memory,
+        "M0": base,
+        "dofs": one["dofs"],
+    }
+
+
+def predict_distributed(model, ranks, cores, iterations=None):
+    """Time [s] and rank 0's memory [MB] of N ranks on the distributed
+    mesh on this machine (N = 1: one process, the whole mesh)."""
+    busy = min(ranks, cores)
+    depth = math.log2(ranks)
+    cg = model["I1"] if iterations is None else iterations
+    several = ranks > 1
+    terms = {
+        "G": model["G1"],
+        "P": model["P2"] if several else 0.0,
+        "Q": ranks * model["q"] if several else 0.0,
+        "H": model["H1"] / busy if several else 0.0,
+        "D": model["D1"] * (model["beta_D"] if several else 1.0) / busy,
+        "K": cg * (model["k1"] / busy + model["c2"] * depth),
+        "A": model["A1"] / busy + model["a2"] * depth,
+        "W": model["W1"],
+    }
+    terms["mesh"] = terms["G"] + terms["P"] + terms["Q"] + terms["H"]
+    terms["run"] = terms["mesh"] + terms["D"] + terms["K"] + terms["A"] + \
+        terms["W"]
+    spread = model["M_replicated"] + model["M_divided"] / ranks
+    terms["memory"] = max(model["M_mesh"], spread) if several else \
+        model["M_replicated"] + model["M_divided"]
+    return terms
+
+
+def extrapolate_distributed(model, alpha, dofs, ranks, contact_faces_ref,
+                            network=ASSUMED_NETWORK):
+    """Time [s] and memory per rank [MB] at @p dofs on @p ranks (one per
+    core) of the distributed mesh as it is (rank 0 reads, partitions and
+    describes the whole mesh; the replicated vectors on every rank) and
+    of the stage after it (the mesh read in parts, every term divided).
+
+    Each cost per DoF is the one measured at model["dofs"]; the CG
+    iterations grow as n^alpha, the contact faces as n^(2/3).
+    """
+    scale = dofs / model["dofs"]
+    cg = model["I1"] * scale ** alpha
+    faces = contact_faces_ref * scale ** (2. / 3.)
+    depth = math.log2(ranks)
+    own = dofs / ranks
+    halo = 6 * (own / 3) ** (2. / 3.) * HALO_BYTES_PER_VERTEX
+    per_iteration_network = (
+        network["latency_s"] * (2 * depth + (4 * LEVELS + 1) * NEIGHBOURS) +
+        (4 * LEVELS + 1) * halo / network["bandwidth_Bps"])
+    # The work per iteration at the rate of two ranks sharing one
+    # machine's memory bandwidth (a cluster's node shares it too).
+    work = (model["k1"] + 2 * model["c2"]) * scale / ranks
+    solve = cg * (work + per_iteration_network) + \
+        model["A1"] * scale / ranks
+    gather = faces * FACE_BYTES / network["bandwidth_Bps"] + \
+        network["latency_s"] * depth
+    divided_work = (model["H1"] + model["D1"] * model["beta_D"]) * scale / \
+        ranks
+    serial = (model["G1"] + model["P2"] + ranks * model["q"] +
+              model["W1"]) * scale
+    surface = faces * FACE_BYTES / 2**20
+    base = model["M0"]
+    now = {
+        "run": serial + divided_work + solve + gather,
+        "memory": base + surface +
+        max(model["M_mesh"] - base,
+            model["M_replicated"] - base + model["M_divided"] / ranks) *
+        scale,
+        "serial": serial,
+    }
+    parts = {
+        # Each rank reads, partitions (in parallel) and writes its own.
+        "run": (model["G1"] + model["P2"] + model["W1"]) * scale / ranks +
+        divided_work + solve + gather,
+        "memory": base + surface +
+        (model["M_replicated"] + model["M_divided"] - base) * scale / ranks,
+    }
+    return {"now": now, "parts": parts, "cg": cg}

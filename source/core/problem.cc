@@ -409,6 +409,9 @@ namespace knee_contact
         release_scene_mesh();
         for (const auto &[step, seconds] : distributed->times)
           mesh_times[step] += seconds;
+        Utilities::System::MemoryStats memory;
+        Utilities::System::get_memory_stats(memory);
+        mesh_peak_MB = memory.VmHWM / 1024.;
         return;
       }
     // Kept whole (the automatic choice, below min_distributed_dofs): made

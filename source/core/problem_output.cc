@@ -89,6 +89,8 @@ namespace knee_contact
     Utilities::System::MemoryStats memory;
     Utilities::System::get_memory_stats(memory);
     solver_figures["peak_memory_MB"] = memory.VmHWM / 1024.;
+    if (mesh_peak_MB > 0)
+      solver_figures["mesh_peak_memory_MB"] = mesh_peak_MB;
     // Where the memory goes (deal.II's own accounting of its objects; the
     // solver's factor is factor_memory_MB).
     solver_figures["memory_mesh_MB"] = mesh().memory_consumption() / 1048576.;

@@ -451,6 +451,12 @@ namespace knee_contact
      * wall_time as "mesh: <step>" (the scaling model's serial terms).
      */
     std::map<std::string, double> mesh_times;
+    /**
+     * This rank's peak resident set [MB] by the end of the last mesh it
+     * distributed (rank 0: the whole mesh and a description at once;
+     * summary.json's solver/mesh_peak_memory_MB), 0 if none.
+     */
+    double mesh_peak_MB = 0;
     // FE_Q(1)^dim or FE_SimplexP(1)^dim, by the mesh's cells (make_mesh).
     std::unique_ptr<FiniteElement<dim>> fe;
     DoFHandler<dim>                     dof_handler;
