@@ -625,15 +625,7 @@ namespace knee_contact
     if (load_cases.values().size() > 1)
       n_failed += run_load_cases(results, sequences, timer);
     else if (output_writer.takes_part())
-      {
-        // No solve follows: the contact system (its factor, or the
-        // iterative path's matrices and hierarchy: 1.4 GB at 1e6 dofs)
-        // goes before the output builds its pieces, which then reuse its
-        // memory instead of adding to the run's peak (at 1e6 dofs the
-        // VTU added 204 MB to one process's, 131 MB to rank 0's of two).
-        contact_system.reset();
-        write_result_set(results, sequences, timer);
-      }
+      write_result_set(results, sequences, timer);
 
     const auto wall_times = phase_times(timer);
     output_writer.commit();
