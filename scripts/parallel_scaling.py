@@ -221,14 +221,7 @@ def print_model(rows, small, base):
                   100 * (assumed["run"] / row["run"] - 1),
                   scaling_model.replicated(row), assumed["R"], row["krylov"],
                   assumed["K"], row["peak"], assumed["memory"]))
-    alpha = 0.0
-    if small:
-        alpha = scaling_model.iteration_exponent(small, by_ranks[1])
-        print("\nCG iterations %d at %d DoFs, %d at %d: alpha %.2f" % (
-            small["cg"], small["dofs"], by_ranks[1]["cg"],
-            by_ranks[1]["dofs"], alpha))
-    print("\nExtrapolated (network assumed: %s; one rank per core):" %
-          scaling_model.ASSUMED_NETWORK)
+    alpha = print_extrapolation_basis(small, by_ranks[1])
     print("\n| DoFs | ranks | CG it. | this stage: run [s] / memory per "
           "rank [GB] | distributed stage: run [s] / memory per rank [GB] |")
     print("|---|---|---|---|---|")
@@ -240,6 +233,20 @@ def print_model(rows, small, base):
                 dofs, ranks, e["cg"], e["stage"]["run"],
                 e["stage"]["memory"] / 1024, e["distributed"]["run"],
                 e["distributed"]["memory"] / 1024))
+
+
+def print_extrapolation_basis(small, one):
+    """The CG iterations' growth exponent from the --small run and the
+    one-rank run @p one (0 without --small), printed with the network the
+    extrapolations assume; returns the exponent."""
+    alpha = 0.0
+    if small:
+        alpha = scaling_model.iteration_exponent(small, one)
+        print("\nCG iterations %d at %d DoFs, %d at %d: alpha %.2f" % (
+            small["cg"], small["dofs"], one["cg"], one["dofs"], alpha))
+    print("\nExtrapolated (network assumed: %s; one rank per core):" %
+          scaling_model.ASSUMED_NETWORK)
+    return alpha
 
 
 def print_distributed_model(by_ranks, small, base):
@@ -266,14 +273,7 @@ def print_distributed_model(by_ranks, small, base):
                   assumed["mesh"], row["descriptions"], assumed["Q"],
                   scaling_model.divided(row), assumed["D"], row["krylov"],
                   assumed["K"], row["peak"], assumed["memory"]))
-    alpha = 0.0
-    if small:
-        alpha = scaling_model.iteration_exponent(small, by_ranks[1])
-        print("\nCG iterations %d at %d DoFs, %d at %d: alpha %.2f" % (
-            small["cg"], small["dofs"], by_ranks[1]["cg"],
-            by_ranks[1]["dofs"], alpha))
-    print("\nExtrapolated (network assumed: %s; one rank per core):" %
-          scaling_model.ASSUMED_NETWORK)
+    alpha = print_extrapolation_basis(small, by_ranks[1])
     print("\n| DoFs | ranks | CG it. | as now: run [s] (rank 0's serial "
           "part) / rank 0's memory [GB] | the mesh read in parts: run [s] / "
           "memory per rank [GB] |")

@@ -140,6 +140,34 @@ def iteration_exponent(small, large):
             math.log(large["dofs"] / small["dofs"]))
 
 
+def _solve_at(model, alpha, dofs, ranks, contact_faces_ref, network):
+    """What both extrapolations share at @p dofs on @p ranks (one per
+    core): the scale n / n_measured, the CG iterations (growing as
+    n^alpha), the contact faces (as n^(2/3)), the divided solve with the
+    network's latency and halos per iteration, and the master surface's
+    gather."""
+    scale = dofs / model["dofs"]
+    cg = model["I1"] * scale ** alpha
+    faces = contact_faces_ref * scale ** (2. / 3.)
+    depth = math.log2(ranks)
+    own = dofs / ranks
+    halo = 6 * (own / 3) ** (2. / 3.) * HALO_BYTES_PER_VERTEX
+    per_iteration_network = (
+        network["latency_s"] * (2 * depth + (4 * LEVELS + 1) * NEIGHBOURS) +
+        (4 * LEVELS + 1) * halo / network["bandwidth_Bps"])
+    # The work per iteration at the rate of two ranks sharing one
+    # machine's memory bandwidth (the N = 2 run: a cluster's node shares
+    # it among its cores too); its excess per iteration taken as the
+    # network's above, since on a cluster the ranks do not share one
+    # machine's bandwidth.
+    work = (model["k1"] + 2 * model["c2"]) * scale / ranks
+    solve = cg * (work + per_iteration_network) + \
+        model["A1"] * scale / ranks
+    gather = faces * FACE_BYTES / network["bandwidth_Bps"] + \
+        network["latency_s"] * depth
+    return scale, cg, faces, solve, gather
+
+
 def extrapolate(model, alpha, dofs, ranks, contact_faces_ref,
                 network=ASSUMED_NETWORK):
     """Time [s] and memory per rank [MB] at @p dofs on @p ranks (one per
@@ -148,28 +176,11 @@ def extrapolate(model, alpha, dofs, ranks, contact_faces_ref,
     Each cost per DoF is the one measured at model["dofs"]; the CG
     iterations grow as n^alpha, the contact faces as n^(2/3).
     """
-    scale = dofs / model["dofs"]
-    cg = model["I1"] * scale ** alpha
-    faces = contact_faces_ref * scale ** (2. / 3.)
-    depth = math.log2(ranks)
+    scale, cg, faces, solve, gather = _solve_at(
+        model, alpha, dofs, ranks, contact_faces_ref, network)
     # This stage: R, W and the replicated memory grow with n and do not
-    # divide; the solve divides (its excess per iteration taken as the
-    # network's below, since on a cluster the ranks do not share one
-    # machine's memory bandwidth).
-    own = dofs / ranks
-    halo = 6 * (own / 3) ** (2. / 3.) * HALO_BYTES_PER_VERTEX
-    per_iteration_network = (
-        network["latency_s"] * (2 * depth + (4 * LEVELS + 1) * NEIGHBOURS) +
-        (4 * LEVELS + 1) * halo / network["bandwidth_Bps"])
-    # The work per iteration and the replicated work at the rate of two
-    # ranks sharing one machine's memory bandwidth (the N = 2 run: a
-    # cluster's node shares it among its cores too).
-    work = (model["k1"] + 2 * model["c2"]) * scale / ranks
-    solve = cg * (work + per_iteration_network) + \
-        model["A1"] * scale / ranks
+    # divide (R at two ranks' rate on one memory bus); the solve divides.
     replicated_work = model["R1"] * model["beta"] * scale
-    gather = faces * FACE_BYTES / network["bandwidth_Bps"] + \
-        network["latency_s"] * depth
     stage = {
         "run": replicated_work + solve + model["W1"] * scale,
         "memory": (model["M_replicated"] + model["P_replicated"]) * scale +
@@ -256,22 +267,8 @@ def extrapolate_distributed(model, alpha, dofs, ranks, contact_faces_ref,
     Each cost per DoF is the one measured at model["dofs"]; the CG
     iterations grow as n^alpha, the contact faces as n^(2/3).
     """
-    scale = dofs / model["dofs"]
-    cg = model["I1"] * scale ** alpha
-    faces = contact_faces_ref * scale ** (2. / 3.)
-    depth = math.log2(ranks)
-    own = dofs / ranks
-    halo = 6 * (own / 3) ** (2. / 3.) * HALO_BYTES_PER_VERTEX
-    per_iteration_network = (
-        network["latency_s"] * (2 * depth + (4 * LEVELS + 1) * NEIGHBOURS) +
-        (4 * LEVELS + 1) * halo / network["bandwidth_Bps"])
-    # The work per iteration at the rate of two ranks sharing one
-    # machine's memory bandwidth (a cluster's node shares it too).
-    work = (model["k1"] + 2 * model["c2"]) * scale / ranks
-    solve = cg * (work + per_iteration_network) + \
-        model["A1"] * scale / ranks
-    gather = faces * FACE_BYTES / network["bandwidth_Bps"] + \
-        network["latency_s"] * depth
+    scale, cg, faces, solve, gather = _solve_at(
+        model, alpha, dofs, ranks, contact_faces_ref, network)
     divided_work = (model["H1"] + model["D1"] * model["beta_D"]) * scale / \
         ranks
     serial = (model["G1"] + model["P2"] + ranks * model["q"] +
