@@ -1344,7 +1344,20 @@ namespace knee_contact
       with_springs && (n_changed > 0.05 * n_held || tied != d.amg_tied);
     // The ranks measure their own times: rank 0's decision holds for all
     // (the set-up is collective; the sets are the same on every rank).
-    bool fresh = !d.has_amg || moved ||
+    // The loop's exact solve of a set that is not the hierarchy's gets a
+    // new one whatever the times say (without springs): the exact solve
+    // takes most of the loop's iterations, and the error bars' influence
+    // solves repeat its set. The rule above decides from the last, loose
+    // solve's excess, small beside the exact solve's, so that the machine's
+    // noise decided (the 3D knee at 232 989 dofs on two ranks, 2026-12-02:
+    // five runs of one hierarchy took 255 CG iterations, one that had
+    // rebuilt 182, its solve 20.3 s against 32.8). Taken from what every
+    // rank knows alike: no broadcast.
+    const bool exact_coming =
+      std::max(d.settings.tolerance, d.accuracy) <= d.settings.tolerance;
+    const bool for_exact = !with_springs && exact_coming && d.has_amg &&
+                           (active != d.amg_active || !ties.rows.empty());
+    bool fresh = !d.has_amg || moved || for_exact ||
                  Utilities::MPI::broadcast(parallel::communicator(), stale, 0);
     if (fresh)
       {
