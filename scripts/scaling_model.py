@@ -49,7 +49,12 @@ into (fit_distributed(), predict_distributed(); rank 0's times):
   D  the rest of the timed work, on each rank's cells (setup, assembly,
      the active-set loop's condensation and decisions, postprocess, error
      estimate): D(N) = D1 beta_D / min(N, C), beta_D = 2 D(2) / D1,
-  K, A, W as above,
+  K, A, W as above, but with I = I2 for N > 1: the CG iterations of the
+     two-rank run, since N > 1 ranks solve another operator than one
+     process (the condensed rows on each rank's part, its own aggregates,
+     against one process's whole matrix): the 3D knee at 1e6 DoFs took
+     482 iterations on one process, 360 on two and 337 on four
+     (2026-12-02); I1 stays one process's,
   memory of rank 0 = max(M_mesh, Mr + Md / N): M_mesh its peak while it
      holds the whole mesh and a description (summary's
      solver/mesh_peak_memory_MB at N = 2, taken constant in N), Mr, Md
@@ -140,14 +145,15 @@ def iteration_exponent(small, large):
             math.log(large["dofs"] / small["dofs"]))
 
 
-def _solve_at(model, alpha, dofs, ranks, contact_faces_ref, network):
+def _solve_at(model, alpha, dofs, ranks, contact_faces_ref, network,
+              iterations="I1"):
     """What both extrapolations share at @p dofs on @p ranks (one per
-    core): the scale n / n_measured, the CG iterations (growing as
-    n^alpha), the contact faces (as n^(2/3)), the divided solve with the
-    network's latency and halos per iteration, and the master surface's
-    gather."""
+    core): the scale n / n_measured, the CG iterations (model[@p
+    iterations], growing as n^alpha), the contact faces (as n^(2/3)), the
+    divided solve with the network's latency and halos per iteration, and
+    the master surface's gather."""
     scale = dofs / model["dofs"]
-    cg = model["I1"] * scale ** alpha
+    cg = model[iterations] * scale ** alpha
     faces = contact_faces_ref * scale ** (2. / 3.)
     depth = math.log2(ranks)
     own = dofs / ranks
@@ -223,6 +229,7 @@ def fit_distributed(one, two, base=0.0):
         "a2": two["amg"] - one["amg"] / 2,
         "W1": one["output"],
         "I1": one["cg"],
+        "I2": two["cg"],
         "M_mesh": two["mesh_peak"],
         "M_replicated": one["peak"] - divided_memory,
         "M_divided": divided_memory,
@@ -233,11 +240,16 @@ def fit_distributed(one, two, base=0.0):
 
 def predict_distributed(model, ranks, cores, iterations=None):
     """Time [s] and rank 0's memory [MB] of N ranks on the distributed
-    mesh on this machine (N = 1: one process, the whole mesh)."""
+    mesh on this machine (N = 1: one process, the whole mesh); @p
+    iterations the CG iterations to assume (default I1 on one rank, the
+    two-rank run's I2 on more)."""
     busy = min(ranks, cores)
     depth = math.log2(ranks)
-    cg = model["I1"] if iterations is None else iterations
     several = ranks > 1
+    if iterations is not None:
+        cg = iterations
+    else:
+        cg = model["I2"] if several else model["I1"]
     terms = {
         "G": model["G1"],
         "P": model["P2"] if several else 0.0,
@@ -265,10 +277,11 @@ def extrapolate_distributed(model, alpha, dofs, ranks, contact_faces_ref,
     of the stage after it (the mesh read in parts, every term divided).
 
     Each cost per DoF is the one measured at model["dofs"]; the CG
-    iterations grow as n^alpha, the contact faces as n^(2/3).
+    iterations, the two-rank run's (I2), grow as n^alpha, the contact
+    faces as n^(2/3).
     """
     scale, cg, faces, solve, gather = _solve_at(
-        model, alpha, dofs, ranks, contact_faces_ref, network)
+        model, alpha, dofs, ranks, contact_faces_ref, network, "I2")
     divided_work = (model["H1"] + model["D1"] * model["beta_D"]) * scale / \
         ranks
     serial = (model["G1"] + model["P2"] + ranks * model["q"] +
