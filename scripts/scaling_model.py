@@ -246,10 +246,8 @@ def predict_distributed(model, ranks, cores, iterations=None):
     busy = min(ranks, cores)
     depth = math.log2(ranks)
     several = ranks > 1
-    if iterations is not None:
-        cg = iterations
-    else:
-        cg = model["I2"] if several else model["I1"]
+    cg = model["I2" if several else "I1"] if iterations is None else \
+        iterations
     terms = {
         "G": model["G1"],
         "P": model["P2"] if several else 0.0,

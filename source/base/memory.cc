@@ -104,6 +104,14 @@ namespace knee_contact
 
 
     double
+    peak_resident_MB()
+    {
+      return read_field("/proc/self/status", "VmHWM:", 1. / 1024.);
+    }
+
+
+
+    double
     address_space_limit()
     {
       rlimit address_space;

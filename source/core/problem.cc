@@ -1,4 +1,5 @@
 #include <knee_contact/base/input.h>
+#include <knee_contact/base/memory.h>
 #include <knee_contact/base/parallel.h>
 #include <knee_contact/base/scene_file.h>
 #include <knee_contact/core/problem.h>
@@ -409,9 +410,7 @@ namespace knee_contact
         release_scene_mesh();
         for (const auto &[step, seconds] : distributed->times)
           mesh_times[step] += seconds;
-        Utilities::System::MemoryStats memory;
-        Utilities::System::get_memory_stats(memory);
-        mesh_peak_MB = memory.VmHWM / 1024.;
+        mesh_peak_MB = memory::peak_resident_MB();
         return;
       }
     // Kept whole (the automatic choice, below min_distributed_dofs): made

@@ -1,5 +1,6 @@
 // The files of a run: result sets, load cases and the results table
 // (ContactProblem's output, split from problem.cc by job).
+#include <knee_contact/base/memory.h>
 #include <knee_contact/base/parallel.h>
 #include <knee_contact/base/progress.h>
 #include <knee_contact/core/problem.h>
@@ -27,10 +28,8 @@ namespace knee_contact
     // The largest peak of the ranks before the output (issue 38's memory
     // per rank; rank 0's own, with the output's, is peak_memory_MB): every
     // rank that takes part in the output comes here, as all do or none.
-    Utilities::System::MemoryStats own;
-    Utilities::System::get_memory_stats(own);
     const double largest_rank_peak_MB =
-      Utilities::MPI::max(own.VmHWM / 1024., parallel::communicator());
+      Utilities::MPI::max(memory::peak_resident_MB(), parallel::communicator());
     const auto write_vtu = [&]() {
       TimerOutput::Scope part(timer, "output: vtu");
       output_writer.write_vtu(dof_handler,
@@ -94,9 +93,7 @@ namespace knee_contact
           write_study_csv(all, out);
         });
     }
-    Utilities::System::MemoryStats memory;
-    Utilities::System::get_memory_stats(memory);
-    solver_figures["peak_memory_MB"] = memory.VmHWM / 1024.;
+    solver_figures["peak_memory_MB"] = memory::peak_resident_MB();
     if (mesh_peak_MB > 0)
       solver_figures["mesh_peak_memory_MB"] = mesh_peak_MB;
     if (parallel::n_ranks() > 1)
@@ -141,8 +138,7 @@ namespace knee_contact
     // Again, with the VTU's time, any warning of the pictures and the
     // peak memory including the VTU's (its thread may still have been
     // building patches when the first summary was written).
-    Utilities::System::get_memory_stats(memory);
-    solver_figures["peak_memory_MB"] = memory.VmHWM / 1024.;
+    solver_figures["peak_memory_MB"] = memory::peak_resident_MB();
     summary();
   }
 

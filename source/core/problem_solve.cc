@@ -2,6 +2,7 @@
 // refinement cycle (ContactProblem's orchestration, split from problem.cc
 // by job as ASPECT splits its Simulator).
 #include <knee_contact/base/input.h>
+#include <knee_contact/base/memory.h>
 #include <knee_contact/base/parallel.h>
 #include <knee_contact/base/progress.h>
 #include <knee_contact/core/problem.h>
@@ -203,9 +204,7 @@ namespace knee_contact
                     << " dofs: peak pressure " << record.peak_pressure
                     << ", energy " << record.energy << ", " << record.total_time
                     << " s" << std::endl;
-        Utilities::System::MemoryStats memory;
-        Utilities::System::get_memory_stats(memory);
-        record.peak_memory = memory.VmHWM / 1024.;
+        record.peak_memory = memory::peak_resident_MB();
         records.push_back(record);
         if (!contact_solution.converged)
           break;

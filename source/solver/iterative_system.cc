@@ -1312,8 +1312,9 @@ namespace knee_contact
     // the error bars repeat the loop's last set: measured on the 3D knee at
     // 2.3e5 dofs, the rule below rebuilt it twice there, since the loop's
     // exact last solve converges at another rate than the loose first one).
-    const bool stale = d.has_amg && d.time_per_product > 0 &&
-                       (active != d.amg_active || !ties.rows.empty()) &&
+    const bool not_the_hierarchys =
+      d.has_amg && (active != d.amg_active || !ties.rows.empty());
+    const bool stale = not_the_hierarchys && d.time_per_product > 0 &&
                        (d.last_iterations - d.last_decades * d.rate_at_build) *
                            d.time_per_product >
                          d.totals.setup / d.totals.n_setups;
@@ -1353,11 +1354,10 @@ namespace knee_contact
     // five runs of one hierarchy took 255 CG iterations, one that had
     // rebuilt 182, its solve 20.3 s against 32.8). Taken from what every
     // rank knows alike: no broadcast.
-    const bool exact_coming =
-      std::max(d.settings.tolerance, d.accuracy) <= d.settings.tolerance;
-    const bool for_exact = !with_springs && exact_coming && d.has_amg &&
-                           (active != d.amg_active || !ties.rows.empty());
-    bool fresh = !d.has_amg || moved || for_exact ||
+    const double target_relative = std::max(d.settings.tolerance, d.accuracy);
+    d.exact                      = target_relative <= d.settings.tolerance;
+    const bool for_exact = !with_springs && d.exact && not_the_hierarchys;
+    bool       fresh     = !d.has_amg || moved || for_exact ||
                  Utilities::MPI::broadcast(parallel::communicator(), stale, 0);
     if (fresh)
       {
@@ -1382,9 +1382,7 @@ namespace knee_contact
       y(line.index) = 0;
     const Vector<double> start = y;
 
-    const double target_relative = std::max(d.settings.tolerance, d.accuracy);
-    d.exact                      = target_relative <= d.settings.tolerance;
-    const double b_norm          = std::max(b.l2_norm(), 1e-300);
+    const double b_norm = std::max(b.l2_norm(), 1e-300);
 
     // With springs, a kept hierarchy gets a budget: 1.5 x the iterations a
     // fresh one would take (its rate per decade of the residual) and those

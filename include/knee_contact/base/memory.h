@@ -27,6 +27,10 @@ namespace knee_contact
     double
     process_virtual();
 
+    /** The process's peak resident memory so far (VmHWM) [MB], or -1. */
+    double
+    peak_resident_MB();
+
     /** "123 MB". */
     std::string
     megabytes(double bytes);
