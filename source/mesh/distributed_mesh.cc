@@ -10,7 +10,10 @@
 #include <deal.II/grid/grid_tools.h>
 #include <deal.II/grid/tria_description.h>
 
+#include <metis.h>
+
 #include <map>
+#include <new>
 #include <tuple>
 #include <utility>
 
@@ -25,6 +28,75 @@ namespace knee_contact
     using MeshPart = std::tuple<TriangulationDescription::Description<dim, dim>,
                                 std::vector<unsigned int>,
                                 std::vector<unsigned int>>;
+
+
+
+    /**
+     * Set @p whole's subdomain ids to a partition of its cells into
+     * @p n_parts parts of about equal size, with few faces between parts:
+     * METIS on the cells' face graph, as deal.II's
+     * GridTools::partition_triangulation() does (recursive bisection up to
+     * 8 parts, k-way beyond, as its SparsityTools::partition() chooses),
+     * but with the graph in METIS's two arrays: deal.II builds it as a
+     * DynamicSparsityPattern and copies it twice, which took rank 0 187 MB
+     * above the whole mesh at 2e6 tetrahedra (doc/parallel.md). @p whole
+     * has one level (distribute() flattens a refined mesh).
+     */
+    template <int dim>
+    void
+    partition_cells(Triangulation<dim> &whole, const unsigned int n_parts)
+    {
+      AssertThrow(whole.n_levels() == 1, ExcInternalError());
+      const unsigned int n_cells = whole.n_active_cells();
+      std::vector<idx_t> part(n_cells, 0);
+      if (n_parts > 1 && n_cells <= n_parts)
+        // More ranks than cells: a cell each, the other ranks none (METIS
+        // wants more vertices than parts).
+        for (unsigned int c = 0; c < n_cells; ++c)
+          part[c] = c;
+      else if (n_parts > 1)
+        {
+          std::vector<idx_t> xadj(n_cells + 1, 0);
+          std::vector<idx_t> adjncy;
+          adjncy.reserve(std::size_t(n_cells) *
+                         whole.begin_active()->n_faces());
+          for (const auto &cell : whole.active_cell_iterators())
+            {
+              for (const unsigned int f : cell->face_indices())
+                if (!cell->at_boundary(f))
+                  adjncy.push_back(cell->neighbor(f)->active_cell_index());
+              xadj[cell->active_cell_index() + 1] = adjncy.size();
+            }
+          idx_t options[METIS_NOPTIONS];
+          METIS_SetDefaultOptions(options);
+          options[METIS_OPTION_NUMBERING] = 0;
+          idx_t n_vertices = n_cells, n_constraints = 1, parts = n_parts,
+                cut = 0;
+          const auto method =
+            n_parts <= 8 ? METIS_PartGraphRecursive : METIS_PartGraphKway;
+          const int status = method(&n_vertices,
+                                    &n_constraints,
+                                    xadj.data(),
+                                    adjncy.empty() ? nullptr : adjncy.data(),
+                                    nullptr,
+                                    nullptr,
+                                    nullptr,
+                                    &parts,
+                                    nullptr,
+                                    nullptr,
+                                    options,
+                                    &cut,
+                                    part.data());
+          if (status == METIS_ERROR_MEMORY)
+            throw std::bad_alloc();
+          AssertThrow(status == METIS_OK,
+                      ExcMessage("METIS failed to partition the mesh's " +
+                                 std::to_string(n_cells) + " cells into " +
+                                 std::to_string(n_parts) + " parts"));
+        }
+      for (const auto &cell : whole.active_cell_iterators())
+        cell->set_subdomain_id(part[cell->active_cell_index()]);
+    }
   } // namespace
 
 
@@ -52,7 +124,7 @@ namespace knee_contact
     Timer                     clock;
     if (Utilities::MPI::this_mpi_process(comm) == 0)
       {
-        GridTools::partition_triangulation(ranks, whole);
+        partition_cells(whole, ranks);
         // A body of the whole mesh by coarse cell: every cell of a coarse
         // cell's tree is of its body.
         body_of_coarse.assign(whole.n_cells(0), 0);

@@ -59,7 +59,7 @@ namespace knee_contact
    * Divide rank 0's whole, checked mesh @p whole and its bodies
    * @p whole_body_of_cell (by active_cell_index(); @p n_bodies of them)
    * over the ranks of the run: rank 0 partitions the cells
-   * (METIS, GridTools::partition_triangulation(), which sets @p whole's
+   * (METIS on the cells' face graph, which sets @p whole's
    * subdomain ids), makes each rank's description (its cells, their ghost
    * layer and the coarse cells they descend from, with material, boundary
    * and manifold ids) and sends it; every rank makes its part of the mesh
