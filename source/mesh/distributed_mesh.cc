@@ -7,7 +7,6 @@
 #include <deal.II/lac/affine_constraints.h>
 
 #include <deal.II/dofs/dof_tools.h>
-#include <deal.II/grid/grid_tools.h>
 #include <deal.II/grid/tria_description.h>
 
 #include <metis.h>
