@@ -13,7 +13,11 @@
 // - every vertex a rank holds names the whole mesh's vertex at its place,
 //   no two the same;
 // - the DoFs of the element (linear, one per vertex and component) are
-//   dim times the whole mesh's vertices.
+//   dim times the whole mesh's vertices;
+// - parallel::gather_on_every_rank() (one MPI_Allgatherv of numbers) gives
+//   every rank the ranks' records in rank order, exactly, where rank r
+//   sends r records (rank 0 none) of doubles and of pairs of indices
+//   (std::array).
 // Printed by rank 0, the same for any number of ranks.
 
 #include <knee_contact/base/parallel.h>
@@ -28,6 +32,7 @@
 #include <deal.II/fe/fe_system.h>
 #include <deal.II/grid/grid_generator.h>
 
+#include <array>
 #include <cmath>
 #include <iostream>
 #include <map>
@@ -238,10 +243,54 @@ namespace
   }
 } // namespace
 
+namespace
+{
+  void
+  check_gather()
+  {
+    const MPI_Comm     comm  = MPI_COMM_WORLD;
+    const unsigned int rank  = Utilities::MPI::this_mpi_process(comm);
+    const unsigned int ranks = Utilities::MPI::n_mpi_processes(comm);
+    // Rank r's records: r of them, the k-th r + k / 8 (exact in binary)
+    // and the pair (r, k).
+    const auto value = [](const unsigned int r, const unsigned int k) {
+      return r + k / 8.;
+    };
+    std::vector<double>                      mine;
+    std::vector<std::array<unsigned int, 2>> mine_pairs;
+    for (unsigned int k = 0; k < rank; ++k)
+      {
+        mine.push_back(value(rank, k));
+        mine_pairs.push_back({rank, k});
+      }
+    const auto all = knee_contact::parallel::gather_on_every_rank(comm, mine);
+    const auto pairs =
+      knee_contact::parallel::gather_on_every_rank(comm, mine_pairs);
+    std::vector<double>                      expected;
+    std::vector<std::array<unsigned int, 2>> expected_pairs;
+    for (unsigned int r = 0; r < ranks; ++r)
+      for (unsigned int k = 0; k < r; ++k)
+        {
+          expected.push_back(value(r, k));
+          expected_pairs.push_back({r, k});
+        }
+    const bool same =
+      Utilities::MPI::min(int(all == expected && pairs == expected_pairs),
+                          comm) == 1;
+    if (rank == 0)
+      std::cout << "gather on every rank: " << expected.size()
+                << " records in rank order on every rank "
+                << (same ? "yes" : "no") << std::endl;
+  }
+} // namespace
+
+
+
 int
 main(int argc, char **argv)
 {
   Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
+  check_gather();
   check<2>(true);
   check<2>(false);
   check<3>(true);

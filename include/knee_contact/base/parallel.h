@@ -7,6 +7,7 @@
 
 #include <functional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace knee_contact
@@ -119,18 +120,49 @@ namespace knee_contact
     working_alone();
     /**
      * Every rank's @p mine on every rank, one after the other in rank
-     * order (deal.II's Utilities::MPI::all_gather, concatenated): the
-     * records a rank flattened into numbers (Gamma lines, contact sides, C's
-     * line rows, the dofs' bodies and positions, the error bars' extremes),
-     * which every rank then reads whole. A collective call on @p comm.
+     * order: the records a rank flattened into numbers (Gamma lines,
+     * contact sides, C's line rows, the dofs' bodies and positions, the
+     * error bars' extremes), which every rank then reads whole. One
+     * MPI_Allgatherv into the result: deal.II's Utilities::MPI::all_gather
+     * serialises and compresses each rank's vector (zlib) and returns the
+     * pieces apart, so that the result was held twice beside the packed
+     * bytes (C's line rows at 1e6 dofs: 2 x 210 MB a rank above the rows
+     * themselves, doc/parallel.md). A collective call on @p comm.
      */
     template <typename T>
     std::vector<T>
     gather_on_every_rank(const MPI_Comm comm, const std::vector<T> &mine)
     {
-      std::vector<T> all;
-      for (const auto &theirs : dealii::Utilities::MPI::all_gather(comm, mine))
-        all.insert(all.end(), theirs.begin(), theirs.end());
+      static_assert(std::is_trivially_copyable_v<T>,
+                    "gathered as bytes: a type of numbers");
+      const std::vector<unsigned long long> counts =
+        dealii::Utilities::MPI::all_gather(
+          comm, static_cast<unsigned long long>(mine.size()));
+      // Counted in records of sizeof(T) bytes (MPI counts are ints).
+      MPI_Datatype record;
+      MPI_Type_contiguous(int(sizeof(T)), MPI_BYTE, &record);
+      MPI_Type_commit(&record);
+      std::vector<int>   sizes(counts.size()), offsets(counts.size());
+      unsigned long long total = 0;
+      for (std::size_t r = 0; r < counts.size(); ++r)
+        {
+          AssertThrow(total + counts[r] <= 2147483647ull,
+                      dealii::ExcMessage(
+                        "more than 2^31 records to gather on every rank"));
+          sizes[r]   = int(counts[r]);
+          offsets[r] = int(total);
+          total += counts[r];
+        }
+      std::vector<T> all(total);
+      MPI_Allgatherv(mine.data(),
+                     int(mine.size()),
+                     record,
+                     all.data(),
+                     sizes.data(),
+                     offsets.data(),
+                     record,
+                     comm);
+      MPI_Type_free(&record);
       return all;
     }
   } // namespace parallel
