@@ -139,9 +139,6 @@ namespace knee_contact
         dealii::Utilities::MPI::all_gather(
           comm, static_cast<unsigned long long>(mine.size()));
       // Counted in records of sizeof(T) bytes (MPI counts are ints).
-      MPI_Datatype record;
-      MPI_Type_contiguous(int(sizeof(T)), MPI_BYTE, &record);
-      MPI_Type_commit(&record);
       std::vector<int>   sizes(counts.size()), offsets(counts.size());
       unsigned long long total = 0;
       for (std::size_t r = 0; r < counts.size(); ++r)
@@ -154,6 +151,9 @@ namespace knee_contact
           total += counts[r];
         }
       std::vector<T> all(total);
+      MPI_Datatype   record;
+      MPI_Type_contiguous(int(sizeof(T)), MPI_BYTE, &record);
+      MPI_Type_commit(&record);
       MPI_Allgatherv(mine.data(),
                      int(mine.size()),
                      record,
