@@ -11,7 +11,9 @@
 
 #include <metis.h>
 
+#include <algorithm>
 #include <map>
+#include <memory>
 #include <new>
 #include <tuple>
 #include <utility>
@@ -101,6 +103,145 @@ namespace knee_contact
 
 
   template <int dim>
+  PartDescriptions<dim>::PartDescriptions(const Triangulation<dim> &whole,
+                                          const unsigned int        n_ranks)
+    : whole(whole)
+    , cells_of_rank(n_ranks)
+  {
+    AssertThrow(whole.n_levels() == 1, ExcInternalError());
+    // deal.II also joins the vertices of periodic faces, which no mesh
+    // here has.
+    AssertThrow(whole.get_periodic_face_map().empty(), ExcInternalError());
+    // The ranks owning a cell at each vertex: the first one in an array,
+    // any further one as a pair (vertex, rank), sorted (only the vertices
+    // at a partition's border have several).
+    const unsigned int        none = numbers::invalid_unsigned_int;
+    std::vector<unsigned int> first(whole.n_vertices(), none);
+    std::vector<std::pair<unsigned int, unsigned int>> further;
+    for (const auto &cell : whole.active_cell_iterators())
+      {
+        const unsigned int rank = cell->subdomain_id();
+        AssertThrow(rank < n_ranks, ExcInternalError());
+        for (const unsigned int v : cell->vertex_indices())
+          {
+            const unsigned int vertex = cell->vertex_index(v);
+            if (first[vertex] == none)
+              first[vertex] = rank;
+            else if (first[vertex] != rank)
+              further.emplace_back(vertex, rank);
+          }
+      }
+    std::sort(further.begin(), further.end());
+    further.erase(std::unique(further.begin(), further.end()), further.end());
+    // A cell is each of its vertices' ranks' (deal.II's "locally relevant"
+    // cells: owned, or a ghost sharing a vertex with an owned one), in
+    // the mesh's order.
+    std::vector<unsigned int> ranks;
+    for (const auto &cell : whole.active_cell_iterators())
+      {
+        ranks.clear();
+        for (const unsigned int v : cell->vertex_indices())
+          {
+            const unsigned int vertex = cell->vertex_index(v);
+            ranks.push_back(first[vertex]);
+            for (auto p = std::lower_bound(further.begin(),
+                                           further.end(),
+                                           std::make_pair(vertex, 0u));
+                 p != further.end() && p->first == vertex;
+                 ++p)
+              ranks.push_back(p->second);
+          }
+        std::sort(ranks.begin(), ranks.end());
+        ranks.erase(std::unique(ranks.begin(), ranks.end()), ranks.end());
+        for (const unsigned int rank : ranks)
+          cells_of_rank[rank].push_back(cell->index());
+      }
+  }
+
+
+
+  template <int dim>
+  const std::vector<unsigned int> &
+  PartDescriptions<dim>::cells(const unsigned int rank) const
+  {
+    return cells_of_rank.at(rank);
+  }
+
+
+
+  template <int dim>
+  TriangulationDescription::Description<dim, dim>
+  PartDescriptions<dim>::description(
+    const unsigned int         rank,
+    const MPI_Comm             comm,
+    std::vector<unsigned int> &vertex_ids) const
+  {
+    const std::vector<unsigned int> &cells = cells_of_rank.at(rank);
+    TriangulationDescription::Description<dim, dim> description;
+    description.comm      = comm;
+    description.settings  = TriangulationDescription::Settings::default_setting;
+    description.smoothing = whole.get_mesh_smoothing();
+    // Its vertices in the whole mesh's order, numbered from 0.
+    vertex_ids.clear();
+    for (const unsigned int c : cells)
+      {
+        const typename Triangulation<dim>::cell_iterator cell(&whole, 0, c);
+        for (const unsigned int v : cell->vertex_indices())
+          vertex_ids.push_back(cell->vertex_index(v));
+      }
+    std::sort(vertex_ids.begin(), vertex_ids.end());
+    vertex_ids.erase(std::unique(vertex_ids.begin(), vertex_ids.end()),
+                     vertex_ids.end());
+    description.coarse_cell_vertices.reserve(vertex_ids.size());
+    for (const unsigned int v : vertex_ids)
+      description.coarse_cell_vertices.push_back(whole.get_vertices()[v]);
+
+    description.coarse_cells.reserve(cells.size());
+    description.coarse_cell_index_to_coarse_cell_id.reserve(cells.size());
+    description.cell_infos.resize(1);
+    description.cell_infos[0].reserve(cells.size());
+    for (const unsigned int c : cells)
+      {
+        const typename Triangulation<dim>::cell_iterator cell(&whole, 0, c);
+        dealii::CellData<dim> coarse(cell->n_vertices());
+        coarse.material_id = cell->material_id();
+        coarse.manifold_id = cell->manifold_id();
+        for (const unsigned int v : cell->vertex_indices())
+          coarse.vertices[v] = std::lower_bound(vertex_ids.begin(),
+                                                vertex_ids.end(),
+                                                cell->vertex_index(v)) -
+                               vertex_ids.begin();
+        description.coarse_cells.push_back(std::move(coarse));
+        description.coarse_cell_index_to_coarse_cell_id.push_back(
+          cell->id().get_coarse_cell_id());
+
+        // (The entries of the manifold ids past a simplex's lines and
+        // faces are flat, not left undefined as deal.II leaves them.)
+        TriangulationDescription::CellData<dim> info{};
+        info.manifold_line_ids.fill(numbers::flat_manifold_id);
+        info.manifold_quad_ids.fill(numbers::flat_manifold_id);
+        info.id = cell->id().template to_binary<dim>();
+        for (const unsigned int f : cell->face_indices())
+          if (const types::boundary_id id = cell->face(f)->boundary_id();
+              id != numbers::internal_face_boundary_id)
+            info.boundary_ids.emplace_back(f, id);
+        info.manifold_id = cell->manifold_id();
+        if (dim >= 2)
+          for (const unsigned int l : cell->line_indices())
+            info.manifold_line_ids[l] = cell->line(l)->manifold_id();
+        if (dim == 3)
+          for (const unsigned int f : cell->face_indices())
+            info.manifold_quad_ids[f] = cell->face(f)->manifold_id();
+        info.subdomain_id       = cell->subdomain_id();
+        info.level_subdomain_id = cell->level_subdomain_id();
+        description.cell_infos[0].push_back(std::move(info));
+      }
+    return description;
+  }
+
+
+
+  template <int dim>
   DistributedMesh<dim>::DistributedMesh()
     : triangulation(parallel::communicator())
   {}
@@ -116,9 +257,9 @@ namespace knee_contact
   {
     const MPI_Comm     comm  = mesh.triangulation.get_communicator();
     const unsigned int ranks = Utilities::MPI::n_mpi_processes(comm);
-    // Rank 0: deal.II's partitioner (METIS on the cells' face graph) and
-    // its descriptions; what is written here is only which rank gets which
-    // and the bodies, which deal.II's description does not carry.
+    // Rank 0: the partition (METIS on the cells' face graph) and every
+    // rank's description, with the bodies (which a description does not
+    // carry).
     std::vector<unsigned int> body_of_coarse;
     Timer                     clock;
     if (Utilities::MPI::this_mpi_process(comm) == 0)
@@ -138,33 +279,19 @@ namespace knee_contact
         mesh.times["partition"] = clock.wall_time();
       }
     clock.restart();
+    std::unique_ptr<PartDescriptions<dim>> descriptions;
+    if (Utilities::MPI::this_mpi_process(comm) == 0)
+      descriptions = std::make_unique<PartDescriptions<dim>>(whole, ranks);
     std::vector<char> bytes =
       parallel::scatter_from_first([&](const unsigned int r) {
         MeshPart<dim> part;
         auto &[description, bodies, vertex_ids] = part;
-        description = TriangulationDescription::Utilities::
-          create_description_from_triangulation(
-            whole,
-            comm,
-            TriangulationDescription::Settings::default_setting,
-            r);
-        // A coarse cell's vertices in the description are those of the
-        // whole mesh's cell of its id, in the same order.
-        vertex_ids.assign(description.coarse_cell_vertices.size(),
-                          numbers::invalid_unsigned_int);
-        for (unsigned int c = 0; c < description.coarse_cells.size(); ++c)
-          {
-            const auto id = description.coarse_cell_index_to_coarse_cell_id[c];
-            bodies.push_back(body_of_coarse.at(id));
-            const typename Triangulation<dim>::cell_iterator cell(&whole,
-                                                                  0,
-                                                                  id);
-            const auto &local = description.coarse_cells[c].vertices;
-            for (unsigned int v = 0; v < local.size(); ++v)
-              vertex_ids.at(local[v]) = cell->vertex_index(v);
-          }
+        description = descriptions->description(r, comm, vertex_ids);
+        for (const unsigned int c : descriptions->cells(r))
+          bodies.push_back(body_of_coarse.at(c));
         return Utilities::pack(part, false);
       });
+    descriptions.reset();
     // On the other ranks: waiting for its description.
     mesh.times["descriptions"] = clock.wall_time();
     clock.restart();
@@ -223,6 +350,8 @@ namespace knee_contact
 
 
 
+  template class PartDescriptions<2>;
+  template class PartDescriptions<3>;
   template struct DistributedMesh<2>;
   template struct DistributedMesh<3>;
   template void

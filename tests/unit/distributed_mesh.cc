@@ -18,6 +18,13 @@
 //   every rank the ranks' records in rank order, exactly, where rank r
 //   sends r records (rank 0 none) of doubles and of pairs of indices
 //   (std::array).
+// - PartDescriptions (every rank's description from one pass over the
+//   whole mesh) gives each rank the description deal.II's
+//   create_description_from_triangulation() gives it (every field; of the
+//   manifold ids the entries of the cell's lines and faces), on these
+//   meshes with manifold ids set on some cells, faces and lines, for two
+//   partitions: one scattering the cells over the ranks (most cells
+//   ghosts somewhere), one leaving the middle ranks no cell.
 // Printed by rank 0, the same for any number of ranks.
 
 #include <knee_contact/base/parallel.h>
@@ -31,6 +38,7 @@
 #include <deal.II/fe/fe_simplex_p.h>
 #include <deal.II/fe/fe_system.h>
 #include <deal.II/grid/grid_generator.h>
+#include <deal.II/grid/tria_description.h>
 
 #include <array>
 #include <cmath>
@@ -245,6 +253,92 @@ namespace
 
 namespace
 {
+  template <int dim>
+  bool
+  same_description(const TriangulationDescription::Description<dim, dim> &a,
+                   const TriangulationDescription::Description<dim, dim> &b,
+                   const Triangulation<dim>                              &whole)
+  {
+    if (!(a.coarse_cells == b.coarse_cells &&
+          a.coarse_cell_vertices == b.coarse_cell_vertices &&
+          a.coarse_cell_index_to_coarse_cell_id ==
+            b.coarse_cell_index_to_coarse_cell_id &&
+          a.settings == b.settings && a.smoothing == b.smoothing &&
+          a.cell_infos.size() == 1 && b.cell_infos.size() == 1 &&
+          a.cell_infos[0].size() == a.coarse_cells.size() &&
+          b.cell_infos[0].size() == a.coarse_cells.size()))
+      return false;
+    for (unsigned int i = 0; i < a.coarse_cells.size(); ++i)
+      {
+        const auto                                      &x = a.cell_infos[0][i];
+        const auto                                      &y = b.cell_infos[0][i];
+        const typename Triangulation<dim>::cell_iterator cell(
+          &whole, 0, a.coarse_cell_index_to_coarse_cell_id[i]);
+        bool same = x.id == y.id && x.subdomain_id == y.subdomain_id &&
+                    x.level_subdomain_id == y.level_subdomain_id &&
+                    x.manifold_id == y.manifold_id &&
+                    x.boundary_ids == y.boundary_ids;
+        for (const unsigned int l : cell->line_indices())
+          same &= x.manifold_line_ids[l] == y.manifold_line_ids[l];
+        if (dim == 3)
+          for (const unsigned int f : cell->face_indices())
+            same &= x.manifold_quad_ids[f] == y.manifold_quad_ids[f];
+        if (!same)
+          return false;
+      }
+    return true;
+  }
+
+  template <int dim>
+  void
+  check_descriptions(const bool simplex)
+  {
+    const MPI_Comm     comm  = knee_contact::parallel::communicator();
+    const unsigned int ranks = Utilities::MPI::n_mpi_processes(comm);
+    Triangulation<dim> whole;
+    make_two_blocks(whole, simplex);
+    for (const auto &cell : whole.active_cell_iterators())
+      {
+        if (cell->index() % 5 == 0)
+          cell->set_manifold_id(3);
+        if (cell->index() % 4 == 1)
+          cell->face(0)->set_manifold_id(4);
+        if (dim == 3 && cell->index() % 3 == 2)
+          cell->line(1)->set_manifold_id(5);
+      }
+    bool same = true;
+    for (unsigned int partition = 0; partition < 2; ++partition)
+      {
+        for (const auto &cell : whole.active_cell_iterators())
+          cell->set_subdomain_id(partition == 0
+                                   ? (7 * cell->index() + 3) % ranks
+                                   : (cell->index() == 0 ? 0 : ranks - 1));
+        const PartDescriptions<dim> descriptions(whole, ranks);
+        for (unsigned int r = 0; r < ranks; ++r)
+          {
+            std::vector<unsigned int> vertex_ids;
+            const auto mine = descriptions.description(r, comm, vertex_ids);
+            const auto reference = TriangulationDescription::Utilities::
+              create_description_from_triangulation(
+                whole,
+                comm,
+                TriangulationDescription::Settings::default_setting,
+                r);
+            same &= same_description(mine, reference, whole);
+            // The vertices' whole indices name the vertices at their place.
+            same &= vertex_ids.size() == mine.coarse_cell_vertices.size();
+            for (unsigned int v = 0; same && v < vertex_ids.size(); ++v)
+              same &= whole.get_vertices()[vertex_ids[v]] ==
+                      mine.coarse_cell_vertices[v];
+          }
+      }
+    if (knee_contact::parallel::rank() == 0)
+      std::cout << dim << "D " << (simplex ? "simplex" : "hypercube")
+                << ": every rank's description that of deal.II (2 "
+                   "partitions) "
+                << (same ? "yes" : "NO") << std::endl;
+  }
+
   void
   check_gather()
   {
@@ -295,4 +389,8 @@ main(int argc, char **argv)
   check<2>(false);
   check<3>(true);
   check<3>(false);
+  check_descriptions<2>(true);
+  check_descriptions<2>(false);
+  check_descriptions<3>(true);
+  check_descriptions<3>(false);
 }

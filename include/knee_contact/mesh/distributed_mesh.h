@@ -6,6 +6,7 @@
 #include <deal.II/distributed/fully_distributed_tria.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/grid/tria.h>
+#include <deal.II/grid/tria_description.h>
 
 #include <map>
 #include <string>
@@ -53,6 +54,44 @@ namespace knee_contact
      * "part" (each rank making its cells from its description).
      */
     std::map<std::string, double> times;
+  };
+
+  /**
+   * Every rank's description of its part of a whole mesh of one level
+   * whose subdomain ids are a partition into @p n_ranks parts, for
+   * parallel::fullydistributed::Triangulation: what deal.II's
+   * TriangulationDescription::Utilities::create_description_from_triangulation()
+   * gives without a multigrid hierarchy (the same cells, vertices, ids and
+   * order: tests/unit/distributed_mesh.cc compares them), but for all ranks
+   * from one pass over the mesh. deal.II's makes each rank's with passes
+   * over the whole mesh (its cells, their vertices, the user flags), which
+   * took rank 0 2.0 s a rank at 1e6 DoFs and grows as the ranks times the
+   * mesh (doc/parallel.md, "The model of the distributed mesh"). The
+   * constructor finds each rank's cells (those with a vertex of a cell it
+   * owns); description() makes one rank's, in time of its cells.
+   */
+  template <int dim>
+  class PartDescriptions
+  {
+  public:
+    PartDescriptions(const Triangulation<dim> &whole,
+                     const unsigned int        n_ranks);
+
+    /** Rank @p rank's description on @p comm, and in @p vertex_ids the
+     * whole mesh's index of each of its vertices. */
+    TriangulationDescription::Description<dim, dim>
+    description(const unsigned int         rank,
+                const MPI_Comm             comm,
+                std::vector<unsigned int> &vertex_ids) const;
+
+    /** The whole mesh's indices of rank @p rank's cells, owned and ghost,
+     * in increasing order (the description's order). */
+    const std::vector<unsigned int> &
+    cells(const unsigned int rank) const;
+
+  private:
+    const Triangulation<dim>              &whole;
+    std::vector<std::vector<unsigned int>> cells_of_rank;
   };
 
   /**
