@@ -42,8 +42,11 @@ into (fit_distributed(), predict_distributed(); rank 0's times):
   G  rank 0 alone makes and checks the whole mesh (summary's "mesh: read";
      one process's whole mesh phase): serial, G(N) = G1,
   P  rank 0's METIS partition ("mesh: partition"): P(N) = P2,
-  Q  rank 0 makes and sends each rank's description ("mesh: descriptions"),
-     each a pass over the whole mesh: Q(N) = N q, q = Q2 / 2,
+  Q  rank 0 makes and sends every rank's description ("mesh: descriptions"):
+     one pass over the whole mesh finds each rank's cells, each
+     description is made from its own (since 2026-12-02 night; deal.II's
+     made each with passes over the whole mesh, N q): Q(N) = Q2, the
+     whole mesh once whatever the ranks,
   H  a rank makes its cells from its description ("mesh: part"):
      H(N) = 2 H2 / min(N, C) (ranks sharing a core take turns),
   D  the rest of the timed work, on each rank's cells (setup, assembly,
@@ -219,7 +222,7 @@ def fit_distributed(one, two, base=0.0):
     return {
         "G1": one["mesh"],
         "P2": two["partition"],
-        "q": two["descriptions"] / 2,
+        "Q2": two["descriptions"],
         "H1": 2 * two["part"],
         "D1": divided(one),
         "beta_D": 2 * divided(two) / divided(one),
@@ -251,7 +254,7 @@ def predict_distributed(model, ranks, cores, iterations=None):
     terms = {
         "G": model["G1"],
         "P": model["P2"] if several else 0.0,
-        "Q": ranks * model["q"] if several else 0.0,
+        "Q": model["Q2"] if several else 0.0,
         "H": model["H1"] / busy if several else 0.0,
         "D": model["D1"] * (model["beta_D"] if several else 1.0) / busy,
         "K": cg * (model["k1"] / busy + model["c2"] * depth),
@@ -282,8 +285,7 @@ def extrapolate_distributed(model, alpha, dofs, ranks, contact_faces_ref,
         model, alpha, dofs, ranks, contact_faces_ref, network, "I2")
     divided_work = (model["H1"] + model["D1"] * model["beta_D"]) * scale / \
         ranks
-    serial = (model["G1"] + model["P2"] + ranks * model["q"] +
-              model["W1"]) * scale
+    serial = (model["G1"] + model["P2"] + model["Q2"] + model["W1"]) * scale
     surface = faces * FACE_BYTES / 2**20
     base = model["M0"]
     now = {

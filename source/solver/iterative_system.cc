@@ -20,6 +20,9 @@
 #include <deal.II/lac/trilinos_sparsity_pattern.h>
 #include <deal.II/lac/trilinos_vector.h>
 
+#include <Epetra_CrsMatrix.h>
+#include <Epetra_Import.h>
+#include <Epetra_Map.h>
 #include <ml_MultiLevelPreconditioner.h>
 #include <mpi.h>
 
@@ -450,12 +453,30 @@ namespace knee_contact
     TrilinosWrappers::SparsityPattern trilinos_pattern;
     /** Several ranks: this rank's rows of C. */
     TrilinosWrappers::SparseMatrix distributed_matrix;
-    /** Several ranks: C's rows of every dof a line can hold (the base's
-     * lines, the dofs of the contact rows; their masters' rows are
-     * owned or in it), on a pattern with no other rows. */
-    std::vector<bool>                 of_line;
-    SparsityPattern                   line_rows_pattern;
-    SparseMatrix<double>              line_rows;
+    /** Several ranks: the dofs a line can hold (the base's lines, the dofs
+     * of the contact rows). */
+    std::vector<bool> of_line;
+    /** Several ranks: C's rows of the lines with a master this rank owns
+     * and a row it does not (condense() reads them), fetched from their
+     * owners when a set first needs them and kept: this rank's part of
+     * the surface. Until 2026-12-02 every rank held C's rows of every dof a
+     * line can hold, whole (181 MB a rank at 1e6 DoFs). */
+    std::map<types::global_dof_index,
+             std::vector<std::pair<types::global_dof_index, double>>>
+      held_rows;
+    /** Several ranks: C's diagonal on every dof a line can hold, on every
+     * rank (the ties' decisions read it, replicated: springs::tie_stiff()),
+     * by dof. */
+    struct DofValue
+    {
+      types::global_dof_index dof;
+      double                  value;
+    };
+    std::vector<DofValue> line_diagonal;
+    /** Several ranks: this rank's rows with a column a line can hold, and
+     * that column (condense() finds the rows a set changes from them). */
+    std::vector<std::pair<types::global_dof_index, types::global_dof_index>>
+                                      line_columns;
     TrilinosWrappers::PreconditionAMG amg;
     bool                              has_amg = false;
     /** The set the hierarchy was built for, and the dofs its tied
@@ -502,27 +523,24 @@ namespace knee_contact
     void
     build_amg(const bool anew = false);
 
-    /** Several ranks: this rank's rows of C into distributed_matrix and
-     * the rows of every dof a line can hold into line_rows, assembled by
-     * @p assemble (C whole is never made). */
+    /** Several ranks: this rank's rows of C into distributed_matrix,
+     * assembled by @p assemble (C whole is never made; on a distributed
+     * mesh @p assemble gives the cells this rank owns), then of_line,
+     * line_diagonal and line_columns. */
     void
     assemble_rows_of_c(const RowAssembly &assemble);
 
-    /** The same on a distributed mesh: @p assemble gives the cells this
-     * rank owns; the line rows come from their owners. */
+    /** Several ranks: into held_rows the rows of the current lines with a
+     * master this rank owns that it holds not yet. Collective. */
     void
-    assemble_rows_on_distributed_mesh(const RowAssembly &assemble);
+    fetch_rows();
 
-    /** The deal.II matrix holding C's rows of the lines (and their
-     * diagonals): C whole (one rank, a whole mesh), else line_rows. */
-    const SparseMatrix<double> &
-    rows_of_c() const
-    {
-      return matrix != nullptr ? *matrix : line_rows;
-    }
+    /** C's diagonal entry of a dof a line can hold (any dof on one rank). */
+    double
+    diagonal(const types::global_dof_index i) const;
 
-    /** Calls @p f(column, value) for each entry of C's row @p row (an
-     * owned row or a line's). */
+    /** Calls @p f(column, value) for each entry of C's row @p row (any row
+     * on one rank; on several an owned row or a held one). */
     template <typename Function>
     void
     for_each_in_row(const types::global_dof_index row, const Function &f) const;
@@ -658,7 +676,10 @@ namespace knee_contact
     // among these. The last set's rows are made again too (to drop what
     // it added); every other row is the base's condensation, the same for
     // every set.
-    std::vector<bool> of_set(n, false);
+    if (matrix == nullptr)
+      fetch_rows();
+    std::vector<bool> of_set(n, false), set_line(n, false);
+    bool              indexed = true;
     for (const auto &line : constraints.get_lines())
       {
         const auto *in_base = base.get_constraint_entries(line.index);
@@ -667,10 +688,40 @@ namespace knee_contact
         of_set[line.index] = true;
         for (const auto &[master, weight] : line.entries)
           of_set[master] = true;
-        for_each_in_row(line.index,
-                        [&](const types::global_dof_index j, const double) {
-                          of_set[j] = true;
-                        });
+        if (matrix != nullptr)
+          for_each_in_row(line.index,
+                          [&](const types::global_dof_index j, const double) {
+                            of_set[j] = true;
+                          });
+        else
+          {
+            set_line[line.index] = true;
+            indexed &= of_line[line.index];
+          }
+      }
+    if (matrix == nullptr)
+      {
+        // Several ranks: a line's row is not here, but C is symmetric: the
+        // rows with the set's lines as columns are those it marks, and of
+        // them the rows this one makes read only its own and the held ones
+        // (a line's row with such a column matters where its masters are
+        // this rank's: it is held). The own ones from line_columns (a line
+        // of a dof no line was expected on: every row).
+        const auto mark = [&](const types::global_dof_index row) {
+          for_each_in_row(row,
+                          [&](const types::global_dof_index j, const double) {
+                            if (set_line[j])
+                              of_set[row] = true;
+                          });
+        };
+        if (indexed)
+          for (const auto &[row, j] : line_columns)
+            of_set[row] = of_set[row] || set_line[j];
+        else
+          for (const auto row : owned)
+            mark(row);
+        for (const auto &[row, entries] : held_rows)
+          mark(row);
       }
     for (const auto &line : constraints.get_lines())
       if (of_set[line.index])
@@ -776,9 +827,8 @@ namespace knee_contact
           {
             const types::global_dof_index j = graph.ColMap().GID(indices[k]);
             row_columns.push_back(j);
-            values.push_back(constrained
-                               ? (j == row ? rows_of_c().diag_element(row) : 0.)
-                               : row_of[j]);
+            values.push_back(constrained ? (j == row ? diagonal(row) : 0.)
+                                         : row_of[j]);
           }
         amg_matrix.set(row,
                        row_columns.size(),
@@ -821,9 +871,49 @@ namespace knee_contact
   IterativeContactSystem::Implementation::assemble_rows_of_c(
     const RowAssembly &assemble)
   {
+    Timer clock;
+    if (distributed_pattern != nullptr)
+      {
+        // Each rank adds the cells it owns (a row another rank owns is sent
+        // to it by compress(): the cells at a partition's border are made
+        // once).
+        distributed_matrix.reinit(*distributed_pattern);
+        assemble([](const types::global_dof_index) { return true; },
+                 [&](const std::vector<types::global_dof_index> &dofs,
+                     const FullMatrix<double>                   &cell_matrix) {
+                   distributed_matrix.add(dofs, cell_matrix);
+                 });
+      }
+    else
+      {
+        // Each rank sums the cells around its rows into them (the cells at
+        // a partition's border on both sides): no rows are sent between
+        // ranks.
+        distributed_matrix.reinit(owned_pattern());
+        std::vector<bool> is_owned(n, false);
+        for (const auto i : owned)
+          is_owned[i] = true;
+        std::vector<double> values;
+        assemble(
+          [&](const types::global_dof_index i) { return bool(is_owned[i]); },
+          [&](const std::vector<types::global_dof_index> &dofs,
+              const FullMatrix<double>                   &cell_matrix) {
+            values.resize(dofs.size());
+            for (unsigned int a = 0; a < dofs.size(); ++a)
+              if (is_owned[dofs[a]])
+                {
+                  for (unsigned int b = 0; b < dofs.size(); ++b)
+                    values[b] = cell_matrix(a, b);
+                  distributed_matrix.add(
+                    dofs[a], dofs.size(), dofs.data(), values.data(), false);
+                }
+          });
+      }
+    distributed_matrix.compress(VectorOperation::add);
+
     // The dofs a line can hold: the base's lines and every dof of a
     // contact row (a row eliminates one of its own dofs; so does a tied
-    // spring, whose dofs are its rows'). O(surface) rows.
+    // spring, whose dofs are its rows'). O(surface) of them.
     of_line.assign(n, false);
     for (const auto &line : base.get_lines())
       of_line[line.index] = true;
@@ -834,128 +924,98 @@ namespace knee_contact
         for (const auto &[j, a] : row.reduced_row)
           of_line[j] = true;
       }
-    if (distributed_pattern != nullptr)
+    // Their diagonal from their owners to every rank; this rank's rows
+    // with such a column.
+    std::vector<DofValue> mine;
+    line_columns.clear();
+    for (const auto row : owned)
       {
-        assemble_rows_on_distributed_mesh(assemble);
-        return;
+        if (of_line[row])
+          mine.push_back({row, distributed_matrix.diag_element(row)});
+        for_each_in_row(row,
+                        [&](const types::global_dof_index j, const double) {
+                          if (of_line[j])
+                            line_columns.emplace_back(row, j);
+                        });
       }
-    std::vector<unsigned int> lengths(n, 1);
-    for (types::global_dof_index i = 0; i < n; ++i)
-      if (of_line[i])
-        lengths[i] = pattern->row_length(i);
-    line_rows_pattern.reinit(n, n, lengths);
-    for (types::global_dof_index i = 0; i < n; ++i)
-      if (of_line[i])
-        for (auto entry = pattern->begin(i); entry != pattern->end(i); ++entry)
-          line_rows_pattern.add(i, entry->column());
-    line_rows_pattern.compress();
-    line_rows.reinit(line_rows_pattern);
-    distributed_matrix.reinit(owned_pattern());
-
-    // Each rank sums the cells around its rows into them (the cells at a
-    // partition's border on both sides): no rows are sent between ranks.
-    Timer             clock;
-    std::vector<bool> is_owned(n, false);
-    for (const auto i : owned)
-      is_owned[i] = true;
-    std::vector<double> values;
-    assemble(
-      [&](const types::global_dof_index i) {
-        return is_owned[i] || of_line[i];
-      },
-      [&](const std::vector<types::global_dof_index> &dofs,
-          const FullMatrix<double>                   &cell_matrix) {
-        values.resize(dofs.size());
-        for (unsigned int a = 0; a < dofs.size(); ++a)
-          if (is_owned[dofs[a]] || of_line[dofs[a]])
-            {
-              for (unsigned int b = 0; b < dofs.size(); ++b)
-                values[b] = cell_matrix(a, b);
-              if (is_owned[dofs[a]])
-                distributed_matrix.add(
-                  dofs[a], dofs.size(), dofs.data(), values.data(), false);
-              if (of_line[dofs[a]])
-                line_rows.add(dofs[a], dofs.size(), dofs.data(), values.data());
-            }
-      });
-    distributed_matrix.compress(VectorOperation::add);
+    line_columns.shrink_to_fit();
+    line_diagonal =
+      parallel::gather_on_every_rank(parallel::communicator(), mine);
+    // (Rank order: each rank's rows are increasing, but on a METIS
+    // partition the ranks' are not contiguous.)
+    std::sort(line_diagonal.begin(),
+              line_diagonal.end(),
+              [](const DofValue &a, const DofValue &b) {
+                return a.dof < b.dof;
+              });
     rows_assembly = clock.wall_time();
   }
 
 
 
   void
-  IterativeContactSystem::Implementation::assemble_rows_on_distributed_mesh(
-    const RowAssembly &assemble)
+  IterativeContactSystem::Implementation::fetch_rows()
   {
-    // Each rank adds the cells it owns (a row another rank owns is sent to
-    // it by compress(): the cells at a partition's border are made once).
-    Timer clock;
-    distributed_matrix.reinit(*distributed_pattern);
-    assemble([](const types::global_dof_index) { return true; },
-             [&](const std::vector<types::global_dof_index> &dofs,
-                 const FullMatrix<double>                   &cell_matrix) {
-               distributed_matrix.add(dofs, cell_matrix);
-             });
-    distributed_matrix.compress(VectorOperation::add);
+    // Why by hand: the rows a rank needs follow the set, so deal.II's
+    // locally relevant sets (made once, from the mesh) do not hold them;
+    // Epetra's Import moves them from their owners.
+    using Index = TrilinosWrappers::types::int_type;
+    std::vector<Index> missing;
+    for (const auto &line : constraints.get_lines())
+      if (!owned.is_element(line.index) && held_rows.count(line.index) == 0)
+        for (const auto &[master, weight] : line.entries)
+          if (owned.is_element(master))
+            {
+              missing.push_back(Index(line.index));
+              break;
+            }
+    const MPI_Comm comm = parallel::communicator();
+    if (Utilities::MPI::max(static_cast<unsigned long>(missing.size()), comm) ==
+        0)
+      return;
+    const Epetra_CrsMatrix &source = distributed_matrix.trilinos_matrix();
+    const Epetra_Map        target(Index(-1),
+                                   int(missing.size()),
+                            missing.empty() ? nullptr : missing.data(),
+                                   0,
+                                   source.Comm());
+    const Epetra_Import     importer(target, source.RowMap());
+    Epetra_CrsMatrix        fetched(Copy, target, 0);
+    AssertThrow(fetched.Import(source, importer, Insert) == 0,
+                ExcInternalError());
+    for (const Index row : missing)
+      {
+        int     length  = 0;
+        double *values  = nullptr;
+        Index  *columns = nullptr;
+        AssertThrow(
+          fetched.ExtractGlobalRowView(row, length, values, columns) == 0,
+          ExcInternalError());
+        auto &held = held_rows[types::global_dof_index(row)];
+        held.reserve(length);
+        for (int k = 0; k < length; ++k)
+          held.emplace_back(types::global_dof_index(columns[k]), values[k]);
+      }
+  }
 
-    // The rows a line can hold, from their owners to every rank (O(surface)
-    // rows; the lines and the contact rows are every rank's, and so are
-    // these rows, as on a whole mesh), packed as doubles for one all-gather
-    // (indices below 2^53): row, length, columns, values.
-    const Epetra_CrsMatrix &epetra = distributed_matrix.trilinos_matrix();
-    std::vector<double>     mine;
-    for (const auto row : owned)
-      if (of_line[row])
-        {
-          int     length  = 0;
-          double *values  = nullptr;
-          int    *columns = nullptr;
-          epetra.ExtractMyRowView(epetra.LRID(
-                                    TrilinosWrappers::types::int_type(row)),
-                                  length,
-                                  values,
-                                  columns);
-          mine.push_back(row);
-          mine.push_back(length);
-          for (int k = 0; k < length; ++k)
-            mine.push_back(epetra.ColMap().GID(columns[k]));
-          mine.insert(mine.end(), values, values + length);
-        }
-    const std::vector<double> all =
-      parallel::gather_on_every_rank(parallel::communicator(), mine);
-    mine = std::vector<double>();
-    // Each gathered row: its index, its length, its columns, its values.
-    const auto for_each_row = [&all](const auto &f) {
-      for (std::size_t k = 0; k < all.size();
-           k += 2 + 2 * std::size_t(all[k + 1]))
-        f(types::global_dof_index(all[k]),
-          static_cast<unsigned int>(all[k + 1]),
-          &all[k + 2],
-          &all[k + 2 + std::size_t(all[k + 1])]);
-    };
-    std::vector<unsigned int> lengths(n, 1);
-    for_each_row([&](const auto row, const unsigned int length, auto, auto) {
-      lengths[row] = std::max(1u, length);
-    });
-    line_rows_pattern.reinit(n, n, lengths);
-    for_each_row([&](const auto         row,
-                     const unsigned int length,
-                     const double      *columns,
-                     auto) {
-      for (unsigned int c = 0; c < length; ++c)
-        line_rows_pattern.add(row, types::global_dof_index(columns[c]));
-    });
-    line_rows_pattern.compress();
-    line_rows.reinit(line_rows_pattern);
-    for_each_row([&](const auto         row,
-                     const unsigned int length,
-                     const double      *columns,
-                     const double      *values) {
-      for (unsigned int c = 0; c < length; ++c)
-        line_rows.set(row, types::global_dof_index(columns[c]), values[c]);
-    });
-    rows_assembly = clock.wall_time();
+
+
+  double
+  IterativeContactSystem::Implementation::diagonal(
+    const types::global_dof_index i) const
+  {
+    if (matrix != nullptr)
+      return matrix->diag_element(i);
+    const auto found =
+      std::lower_bound(line_diagonal.begin(),
+                       line_diagonal.end(),
+                       i,
+                       [](const DofValue &a, const types::global_dof_index j) {
+                         return a.dof < j;
+                       });
+    AssertThrow(found != line_diagonal.end() && found->dof == i,
+                ExcInternalError());
+    return found->value;
   }
 
 
@@ -966,11 +1026,17 @@ namespace knee_contact
     const types::global_dof_index row,
     const Function               &f) const
   {
-    const SparseMatrix<double> &rows = rows_of_c();
-    if (matrix != nullptr || of_line[row])
+    if (matrix != nullptr)
       {
-        for (auto entry = rows.begin(row); entry != rows.end(row); ++entry)
+        for (auto entry = matrix->begin(row); entry != matrix->end(row);
+             ++entry)
           f(entry->column(), entry->value());
+        return;
+      }
+    if (!owned.is_element(row))
+      {
+        for (const auto &[j, value] : held_rows.at(row))
+          f(j, value);
         return;
       }
     // An owned row: Epetra's own view of it (deal.II's iterators over a
@@ -1264,7 +1330,12 @@ namespace knee_contact
     // the Newton iterations of the sparse path (13 and 11); at 0.01 x the
     // first took 15.
     springs::Ties ties = springs::tie_stiff(
-      d.given_springs, d.springs, d.pairs, active, d.rows_of_c(), 1.);
+      d.given_springs,
+      d.springs,
+      d.pairs,
+      active,
+      [&d](const types::global_dof_index i) { return d.diagonal(i); },
+      1.);
     std::vector<ContactRow>        extended;
     const std::vector<ContactRow> *rows = &d.pairs;
     std::vector<bool>              held = active;
@@ -1589,15 +1660,18 @@ namespace knee_contact
   {
     const Implementation &d = *implementation;
     // What every rank holds whole for the contact, the replicated surface
-    // (issue 38's memory bound counts it apart): C's rows of the dofs a
-    // line can hold (none on one rank, which holds C whole) and the
-    // contact rows.
-    double replicated = d.line_rows.memory_consumption() +
-                        d.line_rows_pattern.memory_consumption();
+    // (issue 38's memory bound counts it apart): the contact rows and C's
+    // diagonal on their dofs and the lines'. Until 2026-12-02 C's rows of
+    // all those dofs too (181 MB a rank at 1e6 DoFs); now each rank holds
+    // the rows its part of the condensation reads (held_rows_MB).
+    double replicated = d.line_diagonal.capacity() * sizeof(d.line_diagonal[0]);
     for (const auto &row : d.pairs)
       replicated +=
         sizeof(row) +
         (row.row.capacity() + row.reduced_row.capacity()) * sizeof(row.row[0]);
+    double held = d.line_columns.capacity() * sizeof(d.line_columns[0]);
+    for (const auto &[row, entries] : d.held_rows)
+      held += sizeof(row) + entries.capacity() * sizeof(entries[0]);
     return {{"amg_setups", d.totals.n_setups},
             {"amg_recomputed", d.totals.n_recomputed},
             {"amg_setup", d.totals.setup},
@@ -1613,6 +1687,7 @@ namespace knee_contact
             {"partition", d.partition_time},
             {"rows_assembly", d.rows_assembly},
             {"replicated_rows_MB", replicated / 1048576.},
+            {"held_rows_MB", held / 1048576.},
             {"reference_krylov_iterations", d.reference_iterations}};
   }
 

@@ -114,12 +114,12 @@ namespace knee_contact
 
 
     Ties
-    tie_stiff(const std::vector<ContactSystem::Spring> &springs,
-              const std::vector<SpringTerm>            &terms,
-              const std::vector<ContactRow>            &rows,
-              const std::vector<bool>                  &active,
-              const SparseMatrix<double>               &matrix,
-              const double                              ratio)
+    tie_stiff(const std::vector<ContactSystem::Spring>             &springs,
+              const std::vector<SpringTerm>                        &terms,
+              const std::vector<ContactRow>                        &rows,
+              const std::vector<bool>                              &active,
+              const std::function<double(types::global_dof_index)> &diagonal,
+              const double                                          ratio)
     {
       AssertThrow(springs.size() == terms.size(), ExcInternalError());
       Ties ties;
@@ -141,7 +141,7 @@ namespace knee_contact
           for (const auto &[i, a] : term.w)
             {
               w2 += a * a;
-              wcw += a * a * matrix.diag_element(i);
+              wcw += a * a * diagonal(i);
             }
           if (!(wcw > 0 && term.stiffness * w2 * w2 >= ratio * wcw))
             {

@@ -110,7 +110,8 @@ namespace knee_contact
 
     /**
      * Ties the springs whose stiffness on their own combination w exceeds
-     * @p ratio times the matrix's (k |w|^4 >= ratio sum_i w_i^2 C_ii): each
+     * @p ratio times the matrix's (k |w|^4 >= ratio sum_i w_i^2 C_ii, C_ii
+     * = @p diagonal(i)): each
      * adds one large eigenvalue to K = C + sum k w w^T, which AMG on C does
      * not see, and CG pays for them (the 3D knee's stance at 34 059 dofs:
      * up to 4 682 iterations a solve, against 100 without friction). Held as w
@@ -124,12 +125,12 @@ namespace knee_contact
      * does not.
      */
     Ties
-    tie_stiff(const std::vector<ContactSystem::Spring> &springs,
-              const std::vector<SpringTerm>            &terms,
-              const std::vector<ContactRow>            &rows,
-              const std::vector<bool>                  &active,
-              const SparseMatrix<double>               &matrix,
-              const double                              ratio);
+    tie_stiff(const std::vector<ContactSystem::Spring>             &springs,
+              const std::vector<SpringTerm>                        &terms,
+              const std::vector<ContactRow>                        &rows,
+              const std::vector<bool>                              &active,
+              const std::function<double(types::global_dof_index)> &diagonal,
+              const double                                          ratio);
 
     /**
      * After a solve with @p ties held (their multipliers at
