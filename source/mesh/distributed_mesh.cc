@@ -181,17 +181,25 @@ namespace knee_contact
     description.comm      = comm;
     description.settings  = TriangulationDescription::Settings::default_setting;
     description.smoothing = whole.get_mesh_smoothing();
-    // Its vertices in the whole mesh's order, numbered from 0.
+    // Its vertices in the whole mesh's order, numbered from 0 (by an array
+    // over the whole mesh's vertices: a search per vertex took a quarter
+    // more time).
+    const unsigned int        none = numbers::invalid_unsigned_int;
+    std::vector<unsigned int> local(whole.n_vertices(), none);
     vertex_ids.clear();
     for (const unsigned int c : cells)
       {
         const typename Triangulation<dim>::cell_iterator cell(&whole, 0, c);
         for (const unsigned int v : cell->vertex_indices())
-          vertex_ids.push_back(cell->vertex_index(v));
+          if (local[cell->vertex_index(v)] == none)
+            {
+              local[cell->vertex_index(v)] = 0;
+              vertex_ids.push_back(cell->vertex_index(v));
+            }
       }
     std::sort(vertex_ids.begin(), vertex_ids.end());
-    vertex_ids.erase(std::unique(vertex_ids.begin(), vertex_ids.end()),
-                     vertex_ids.end());
+    for (unsigned int k = 0; k < vertex_ids.size(); ++k)
+      local[vertex_ids[k]] = k;
     description.coarse_cell_vertices.reserve(vertex_ids.size());
     for (const unsigned int v : vertex_ids)
       description.coarse_cell_vertices.push_back(whole.get_vertices()[v]);
@@ -207,10 +215,7 @@ namespace knee_contact
         coarse.material_id = cell->material_id();
         coarse.manifold_id = cell->manifold_id();
         for (const unsigned int v : cell->vertex_indices())
-          coarse.vertices[v] = std::lower_bound(vertex_ids.begin(),
-                                                vertex_ids.end(),
-                                                cell->vertex_index(v)) -
-                               vertex_ids.begin();
+          coarse.vertices[v] = local[cell->vertex_index(v)];
         description.coarse_cells.push_back(std::move(coarse));
         description.coarse_cell_index_to_coarse_cell_id.push_back(
           cell->id().get_coarse_cell_id());
