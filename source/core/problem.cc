@@ -305,10 +305,10 @@ namespace knee_contact
 
   template <int dim>
   void
-  ContactProblem<dim>::make_mesh(const int level)
+  ContactProblem<dim>::make_mesh(const int level, const bool distributed)
   {
     release_distributed_mesh();
-    mesh_input.create(triangulation, level);
+    mesh_input.create(triangulation, level, distributed);
     fe =
       elements::displacement_element<dim>(elements::cell_kind(triangulation));
     materials.check_mesh(triangulation);
@@ -389,8 +389,8 @@ namespace knee_contact
   {
     // Every rank holding the whole mesh took N times its memory on a
     // machine (1.6 GB a rank at 1e6 dofs) and N reads of its file at once.
-    const auto make_checked_mesh = [&]() {
-      make_mesh(level);
+    const auto make_checked_mesh = [&](const bool distributed) {
+      make_mesh(level, distributed);
       scene_checks::check_finite_data(triangulation,
                                       materials,
                                       boundary_conditions);
@@ -399,7 +399,23 @@ namespace knee_contact
     Timer clock;
     distributed_reason = parallel::on_first_rank(
       [&]() {
-        make_checked_mesh();
+        make_checked_mesh(true);
+        if constexpr (dim == 3)
+          {
+            // The memory check's estimate, for summary.json (as
+            // make_mesh() counts the mesh).
+            const bool tetrahedra =
+              triangulation.all_reference_cells_are_simplex();
+            double first = 0, other = 0;
+            estimated_distributed_bytes(
+              tetrahedra ? 2. * triangulation.n_used_vertices() :
+                           double(triangulation.n_active_cells()),
+              tetrahedra,
+              first,
+              other);
+            estimated_first_MB = first / 1048576.;
+            estimated_other_MB = other / 1048576.;
+          }
         return distribution_reason(strategy);
       },
       "make and check the mesh");
@@ -416,7 +432,7 @@ namespace knee_contact
     // Kept whole (the automatic choice, below min_distributed_dofs): made
     // as on every rank, rank 0's anew too, since gmsh's outcome is shared
     // by all ranks (MeshInput).
-    make_checked_mesh();
+    make_checked_mesh(false);
   }
 
 

@@ -96,6 +96,11 @@ namespace knee_contact
     solver_figures["peak_memory_MB"] = memory::peak_resident_MB();
     if (mesh_peak_MB > 0)
       solver_figures["mesh_peak_memory_MB"] = mesh_peak_MB;
+    if (estimated_first_MB > 0)
+      {
+        solver_figures["estimated_first_rank_MB"] = estimated_first_MB;
+        solver_figures["estimated_rank_MB"]       = estimated_other_MB;
+      }
     if (parallel::n_ranks() > 1)
       solver_figures["largest_rank_peak_memory_MB"] = largest_rank_peak_MB;
     // Where the memory goes (deal.II's own accounting of its objects; the

@@ -272,7 +272,8 @@ namespace knee_contact
   template <int dim>
   void
   MeshInput<dim>::create(Triangulation<dim> &triangulation,
-                         const int           level) const
+                         const int           level,
+                         const bool          distributed) const
   {
     triangulation.clear();
     // A level below 0 (the coarse start): a .geo meshed by gmsh at 2^-level
@@ -349,7 +350,8 @@ namespace knee_contact
                      (tetrahedra ? " (tetrahedra: as hexahedra of twice its "
                                    "vertices)"
                                  : ""),
-                   tetrahedra);
+                   tetrahedra,
+                   distributed);
     triangulation.refine_global(n_refine);
     if (n_refine > 0)
       check_cells(triangulation);
@@ -527,15 +529,65 @@ namespace knee_contact
 
 
   void
+  estimated_distributed_bytes(const double n_cells,
+                              const bool   tetrahedra,
+                              double      &first,
+                              double      &other)
+  {
+    // Measured on the 3D knee's tetrahedra at 1.0e6 dofs (doc/parallel.md,
+    // 2026-12-02): one process 4.0 GB (the estimate above 4.35); on N
+    // ranks each holds 491 MB (the program's 176 and 0.3 kB a dof: the
+    // vectors, the contact rows, whole) and 3.5 kB a dof divided (the mesh
+    // part, DoFs, C's rows, the hierarchy); rank 0 holds the whole mesh
+    // and its part first: 1.64 GB on two ranks, 1.22 on four. Here 0.4 kB
+    // a dof whole, the rest of the one-process estimate divided, and 1.5
+    // kB a dof for rank 0's mesh phase.
+    const double dofs    = (tetrahedra ? 1.5 : 3.) * n_cells;
+    const double entries = tetrahedra ? 45 : 81;
+    const double ranks   = parallel::n_ranks();
+    other  = 5e7 + dofs * (400. + (2.1e3 + 40. * entries) / ranks);
+    first  = std::max(other, 5e7 + 1.5e3 * dofs);
+  }
+
+
+
+  void
   check_run_fits(const unsigned int dim,
                  const double       n_cells,
                  const std::string &what,
-                 const bool         tetrahedra)
+                 const bool         tetrahedra,
+                 const bool         distributed)
   {
-    std::string  limit;
-    const double available = memory::available(limit);
-    const double needed    = estimated_run_bytes(dim, n_cells, tetrahedra);
-    const auto   gigabytes = [](const double bytes) {
+    // (A 2D run's estimate is that of its whole mesh on every rank.)
+    const bool  divided = distributed && dim == 3 && parallel::n_ranks() > 1;
+    std::string limit;
+    double      available = memory::available(limit, !divided);
+    double      needed    = estimated_run_bytes(dim, n_cells, tetrahedra);
+    std::string whose;
+    if (divided)
+      {
+        // The machine's share of a rank (memory::available()) against
+        // what its ranks hold on average: rank 0 more, the others their
+        // share; rank 0's own against an address-space limit.
+        double first = 0, other = 0;
+        estimated_distributed_bytes(n_cells, tetrahedra, first, other);
+        const double here = parallel::ranks_on_this_machine();
+        needed            = (first + (here - 1) * other) / here;
+        whose             = " a rank on the distributed mesh";
+        if (memory::address_space_limited())
+          {
+            const double room =
+              memory::address_space_limit() - memory::process_virtual();
+            if (room - first < available - needed)
+              {
+                available = room;
+                needed    = first;
+                whose     = " on rank 0, which makes the distributed mesh";
+                limit     = "the address-space limit (ulimit -v)";
+              }
+          }
+      }
+    const auto gigabytes = [](const double bytes) {
       std::ostringstream out;
       out << std::setprecision(3) << bytes / 1e9 << " GB";
       return out.str();
@@ -544,9 +596,10 @@ namespace knee_contact
     cells << std::setprecision(3) << n_cells;
     AssertThrow(needed < available,
                 ExcMessage(what + ": about " + cells.str() +
-                           " cells need about " + gigabytes(needed) + "; " +
-                           gigabytes(available) + " are available (" + limit +
-                           ")"));
+                           " cells need about " + gigabytes(needed) +
+                           whose +
+                           "; " + gigabytes(available) + " are available (" +
+                           limit + ")"));
   }
 
 

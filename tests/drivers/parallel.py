@@ -32,7 +32,9 @@
    rank): a bad parameter, a mesh refused where it may be distributed
    (rank 0 alone makes and checks it, the other takes its refusal) and a
    .geo gmsh refuses (rank 0 alone runs gmsh, the others take its
-   failure).
+   failure); and a mesh too large where it may be distributed, refused by
+   the distributed run's estimate ("a rank on the distributed mesh"),
+   said once.
 Under the sanitizers (SANITIZE = ON) the scenes whose code under mpirun is
 that of another scene here are left out (SANITIZER_SKIPS): each run there
 is 3 to 7 times slower, and the adaptive Hertz sphere alone took 200 s.
@@ -508,6 +510,33 @@ def main():
                                    "Slave boundary id  = 1")
                      .replace("@FOLDER@", os.path.join(folder, "same")),
                      "both lie on body", failures)
+
+        # A mesh too large for the machine where it may be distributed:
+        # rank 0's check counts the distributed run (the ranks' shares,
+        # rank 0's whole mesh) and refuses it in one line, said once; one
+        # process refuses it with the whole run's estimate.
+        large = scene_text("contact_patch_3d_hex.prm", "iterative",
+                           [(r"(set Gmsh arguments.*)",
+                             r"\1\n  set Global refinements = 12")],
+                           os.path.join(folder, "large"))
+        large_scene = os.path.join(folder, "large.prm")
+        with open(large_scene, "w") as f:
+            f.write(large)
+        alone = run(binary, large_scene, 0)
+        result = run(binary, large_scene, 2)
+        said = [line for line in result.stderr.splitlines()
+                if line.startswith("knee_contact: error:")]
+        print("a mesh too large on 2 ranks: exit code %d (one process %d), "
+              "%d error line(s): %s" % (result.returncode, alone.returncode,
+                                        len(said), said))
+        if result.returncode != 1 or alone.returncode != 1 or \
+                len(said) != 1 or \
+                "cells need about" not in said[0] or \
+                "a rank on the distributed mesh" not in said[0] or \
+                "cells need about" not in alone.stderr or \
+                "distributed" in alone.stderr:
+            failures.append("a mesh too large on 2 ranks: exit code %d, "
+                            "error lines %s" % (result.returncode, said))
 
         # A .geo gmsh refuses: rank 0 alone meshes, the others take its
         # failure.

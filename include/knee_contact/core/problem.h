@@ -209,10 +209,11 @@ namespace knee_contact
     /**
      * The mesh at refinement @p level: 0 on the first cycle; > 0 where the
      * mesh input remeshes instead of refining (MeshInput::remeshes()) or
-     * the distributed mesh of a uniform sequence is made anew.
+     * the distributed mesh of a uniform sequence is made anew;
+     * @p distributed: rank 0 makes it to divide it (its memory check).
      */
     void
-    make_mesh(const int level);
+    make_mesh(const int level, const bool distributed = false);
 
     /**
      * Why this mesh (the whole one make_mesh() made) is to be distributed
@@ -457,6 +458,13 @@ namespace knee_contact
      * summary.json's solver/mesh_peak_memory_MB), 0 if none.
      */
     double mesh_peak_MB = 0;
+    /**
+     * Rank 0: the memory check's estimate of the last distributed mesh's
+     * run [MB], rank 0's and another rank's (estimated_distributed_bytes();
+     * summary.json's solver/estimated_first_rank_MB, estimated_rank_MB), 0
+     * if none.
+     */
+    double estimated_first_MB = 0, estimated_other_MB = 0;
     // FE_Q(1)^dim or FE_SimplexP(1)^dim, by the mesh's cells (make_mesh).
     std::unique_ptr<FiniteElement<dim>> fe;
     DoFHandler<dim>                     dof_handler;

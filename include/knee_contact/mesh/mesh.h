@@ -92,10 +92,14 @@ namespace knee_contact
 
     /**
      * Build the coarse mesh, attach the circular manifolds and refine
-     * globally as asked.
+     * globally as asked. @p distributed: the mesh is made on rank 0 to be
+     * divided over the ranks (its memory check counts the distributed run's,
+     * check_run_fits()).
      */
     void
-    create(Triangulation<dim> &triangulation, const int level = 0) const;
+    create(Triangulation<dim> &triangulation,
+           const int           level       = 0,
+           const bool          distributed = false) const;
 
     /**
      * Whether refinement cycles remesh instead of refining @p triangulation:
@@ -294,17 +298,32 @@ namespace knee_contact
                       bool         tetrahedra = false);
 
   /**
+   * The same for a run whose mesh rank 0 makes whole and divides over the
+   * run's N ranks (the distributed mesh: the iterative path), per rank:
+   * @p first rank 0's (the whole mesh and its part, or its share of the
+   * run after), @p other every other rank's share.
+   */
+  void
+  estimated_distributed_bytes(double  n_cells,
+                              bool    tetrahedra,
+                              double &first,
+                              double &other);
+
+  /**
    * Refuse, before anything of the size is allocated, a mesh of @p n_cells
    * cells that the memory available to the process (memory::available())
    * cannot hold: "<what>: about N cells need about X GB; Y GB are
    * available (MemAvailable)". @p what names the file and line or the
-   * parameter that asks for the size.
+   * parameter that asks for the size. @p distributed: rank 0 makes the
+   * mesh to divide it (estimated_distributed_bytes()); the ranks of a
+   * machine share its memory by what each holds, not equally.
    */
   void
   check_run_fits(unsigned int       dim,
                  double             n_cells,
                  const std::string &what,
-                 bool               tetrahedra = false);
+                 bool               tetrahedra  = false,
+                 bool               distributed = false);
 } // namespace knee_contact
 
 #endif
