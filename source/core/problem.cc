@@ -407,12 +407,13 @@ namespace knee_contact
             const bool tetrahedra =
               triangulation.all_reference_cells_are_simplex();
             double first = 0, other = 0;
-            estimated_distributed_bytes(
-              tetrahedra ? 2. * triangulation.n_used_vertices() :
-                           double(triangulation.n_active_cells()),
-              tetrahedra,
-              first,
-              other);
+            estimated_distributed_bytes(tetrahedra
+                                          ? 2. * triangulation.n_used_vertices()
+                                          : double(
+                                              triangulation.n_active_cells()),
+                                        tetrahedra,
+                                        first,
+                                        other);
             estimated_first_MB = first / 1048576.;
             estimated_other_MB = other / 1048576.;
           }

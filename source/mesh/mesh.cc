@@ -545,8 +545,8 @@ namespace knee_contact
     const double dofs    = (tetrahedra ? 1.5 : 3.) * n_cells;
     const double entries = tetrahedra ? 45 : 81;
     const double ranks   = parallel::n_ranks();
-    other  = 5e7 + dofs * (400. + (2.1e3 + 40. * entries) / ranks);
-    first  = std::max(other, 5e7 + 1.5e3 * dofs);
+    other = 5e7 + dofs * (400. + (2.1e3 + 40. * entries) / ranks);
+    first = std::max(other, 5e7 + 1.5e3 * dofs);
   }
 
 
@@ -596,8 +596,7 @@ namespace knee_contact
     cells << std::setprecision(3) << n_cells;
     AssertThrow(needed < available,
                 ExcMessage(what + ": about " + cells.str() +
-                           " cells need about " + gigabytes(needed) +
-                           whose +
+                           " cells need about " + gigabytes(needed) + whose +
                            "; " + gigabytes(available) + " are available (" +
                            limit + ")"));
   }
