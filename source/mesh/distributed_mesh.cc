@@ -285,22 +285,33 @@ namespace knee_contact
       }
     clock.restart();
     std::unique_ptr<PartDescriptions<dim>> descriptions;
-    if (Utilities::MPI::this_mpi_process(comm) == 0)
+    const bool first = Utilities::MPI::this_mpi_process(comm) == 0;
+    if (first)
       descriptions = std::make_unique<PartDescriptions<dim>>(whole, ranks);
+    const auto part_of = [&](const unsigned int r) {
+      MeshPart<dim> part;
+      auto &[description, bodies, vertex_ids] = part;
+      description = descriptions->description(r, comm, vertex_ids);
+      for (const unsigned int c : descriptions->cells(r))
+        bodies.push_back(body_of_coarse.at(c));
+      return part;
+    };
+    // Rank 0's own part is made in place after the others' are sent, not
+    // packed and unpacked: rank 0 is the last to start its part.
     std::vector<char> bytes =
       parallel::scatter_from_first([&](const unsigned int r) {
-        MeshPart<dim> part;
-        auto &[description, bodies, vertex_ids] = part;
-        description = descriptions->description(r, comm, vertex_ids);
-        for (const unsigned int c : descriptions->cells(r))
-          bodies.push_back(body_of_coarse.at(c));
-        return Utilities::pack(part, false);
+        return r == 0 ? std::vector<char>()
+                      : Utilities::pack(part_of(r), false);
       });
+    MeshPart<dim> part;
+    if (first)
+      part = part_of(0);
     descriptions.reset();
     // On the other ranks: waiting for its description.
     mesh.times["descriptions"] = clock.wall_time();
     clock.restart();
-    MeshPart<dim> part = Utilities::unpack<MeshPart<dim>>(bytes, false);
+    if (!first)
+      part = Utilities::unpack<MeshPart<dim>>(bytes, false);
     std::vector<char>().swap(bytes);
     const auto &[description, bodies, vertex_ids] = part;
     // The bodies by the coarse cell's id, which every cell's CellId starts
