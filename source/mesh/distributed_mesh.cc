@@ -262,12 +262,13 @@ namespace knee_contact
   {
     const MPI_Comm     comm  = mesh.triangulation.get_communicator();
     const unsigned int ranks = Utilities::MPI::n_mpi_processes(comm);
+    const bool         first = Utilities::MPI::this_mpi_process(comm) == 0;
     // Rank 0: the partition (METIS on the cells' face graph) and every
     // rank's description, with the bodies (which a description does not
     // carry).
     std::vector<unsigned int> body_of_coarse;
     Timer                     clock;
-    if (Utilities::MPI::this_mpi_process(comm) == 0)
+    if (first)
       {
         partition_cells(whole, ranks);
         // A body of the whole mesh by coarse cell: every cell of a coarse
@@ -285,7 +286,6 @@ namespace knee_contact
       }
     clock.restart();
     std::unique_ptr<PartDescriptions<dim>> descriptions;
-    const bool first = Utilities::MPI::this_mpi_process(comm) == 0;
     if (first)
       descriptions = std::make_unique<PartDescriptions<dim>>(whole, ranks);
     const auto part_of = [&](const unsigned int r) {
