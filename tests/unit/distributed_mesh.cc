@@ -165,8 +165,13 @@ namespace
       compute_body_ids(whole, n_bodies);
     const Measures reference = measures(whole, whole_body);
 
+    // distribute_mesh() clears rank 0's mesh: a copy goes in.
+    Triangulation<dim> given;
+    given.copy_triangulation(whole);
     DistributedMesh<dim> mesh;
-    distribute_mesh(whole, whole_body, n_bodies, mesh);
+    distribute_mesh(given, whole_body, n_bodies, mesh);
+    const bool released =
+      Utilities::MPI::broadcast(comm, given.n_cells() == 0, 0);
     const auto        &tria  = mesh.triangulation;
     const Measures     mine  = measures(tria, mesh.body_of_cell);
     const unsigned int owned = tria.n_locally_owned_active_cells();
@@ -247,7 +252,8 @@ namespace
                 << (agree ? "yes" : "NO") << ", vertices name the whole mesh's "
                 << (ids_agree ? "yes" : "NO") << "\n  dofs " << dofs.n_dofs()
                 << (dofs.n_dofs() == dim * whole.n_vertices() ? " = " : " != ")
-                << "dim x vertices" << std::endl;
+                << "dim x vertices, rank 0's whole mesh released "
+                << (released ? "yes" : "NO") << std::endl;
   }
 } // namespace
 
