@@ -1,8 +1,11 @@
 #ifndef knee_contact_gmsh_input_h
 #define knee_contact_gmsh_input_h
 
+#include <knee_contact/mesh/mesh_readers.h>
+
 #include <set>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace knee_contact
@@ -87,6 +90,27 @@ namespace knee_contact
      */
     unsigned int
     check_msh(const std::string &file);
+
+    /**
+     * The vertices, cells and boundary faces of the ASCII .msh text
+     * @p text (a file check_msh() passed, or one_group_per_entity()'s text
+     * of it), exactly as deal.II 9.4's
+     * GridIn::read_msh(std::istream &) hands them to
+     * Triangulation::create_triangulation(): vertices in the order of
+     * $Nodes, a cell's material id and a face's boundary id its physical
+     * group (0 without), the vertices of quadrilaterals and hexahedra in
+     * deal.II's order, lines (and in 3D triangles and quadrilaterals) as
+     * boundary faces, and GridIn's clean-up (a mesh of quadrilaterals or
+     * hexahedra loses its unused vertices and has its cells ordered
+     * consistently; inverted cells are turned over).
+     * tests/unit/msh_read.cc compares the two on meshes of both versions.
+     * Unlike GridIn it skips sections it does not read wherever they are,
+     * and reads the parametric coordinates of a node by its entity's
+     * dimension. Its errors say what is wrong, the caller names the file.
+     */
+    template <int dim>
+    mesh_readers::Description<dim>
+    read_msh(const std::string_view text);
 
     /**
      * The checked .msh @p msh (2.2 or 4.1) with every entity in one

@@ -153,8 +153,9 @@ namespace knee_contact
     read_file(Triangulation<dim> &triangulation, const int level) const;
 
     /**
-     * The Gmsh mesh at refinement @p level (see remeshes()), read by
-     * deal.II's GridIn into @p triangulation.
+     * The Gmsh mesh at refinement @p level (see remeshes()), read as
+     * deal.II's GridIn reads it (gmsh_input::read_msh()) into
+     * @p triangulation.
      */
     void
     read_gmsh(const int level, Triangulation<dim> &triangulation) const;
