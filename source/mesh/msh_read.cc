@@ -70,6 +70,16 @@ namespace knee_contact
           return value;
         }
 
+        // An integer that counts something: not negative.
+        long long
+        count()
+        {
+          const long long n = integer();
+          if (n < 0)
+            fail("a negative count");
+          return n;
+        }
+
         double
         real()
         {
@@ -224,14 +234,14 @@ namespace knee_contact
             {
               long long n[4];
               for (auto &count : n)
-                count = words.integer();
+                count = words.count();
               for (unsigned int d = 0; d < 4; ++d)
                 for (long long e = 0; e < n[d]; ++e)
                   {
                     const long long tag = words.integer();
                     for (unsigned int k = 0; k < (d == 0 ? 3 : 6); ++k)
                       words.real();
-                    const long long n_physical = words.integer();
+                    const long long n_physical = words.count();
                     if (n_physical > 1)
                       words.fail("entity " + std::to_string(tag) +
                                  " in several physical groups");
@@ -240,7 +250,7 @@ namespace knee_contact
                       group = words.integer();
                     physical[d][tag] = group;
                     if (d > 0)
-                      for (long long k = words.integer(); k > 0; --k)
+                      for (long long k = words.count(); k > 0; --k)
                         words.integer();
                   }
               words.expect("$EndEntities");
@@ -250,14 +260,14 @@ namespace knee_contact
               long long n_blocks = 1, n_total = 0;
               if (v4)
                 {
-                  n_blocks              = words.integer();
-                  n_total               = words.integer();
+                  n_blocks              = words.count();
+                  n_total               = words.count();
                   const long long first = words.integer();
                   node_index.reserve(first, words.integer(), n_total);
                 }
               else
                 {
-                  n_total = words.integer();
+                  n_total = words.count();
                   node_index.reserve(1, n_total, n_total);
                 }
               mesh.vertices.reserve(n_total);
@@ -270,7 +280,7 @@ namespace knee_contact
                       entity_dim = words.integer();
                       words.integer();
                       parametric = words.integer();
-                      n          = words.integer();
+                      n          = words.count();
                       tags.resize(n);
                       for (auto &tag : tags)
                         tag = words.integer();
@@ -299,13 +309,13 @@ namespace knee_contact
               long long n_blocks = 1, n_total = 0;
               if (v4)
                 {
-                  n_blocks = words.integer();
-                  n_total  = words.integer();
+                  n_blocks = words.count();
+                  n_total  = words.count();
                   words.integer();
                   words.integer();
                 }
               else
-                n_total = words.integer();
+                n_total = words.count();
               for (long long b = 0; b < n_blocks; ++b)
                 {
                   long long type = 0, n = n_total, id = 0;
@@ -314,7 +324,7 @@ namespace knee_contact
                       const long long entity_dim = words.integer();
                       const long long entity     = words.integer();
                       type                       = words.integer();
-                      n                          = words.integer();
+                      n                          = words.count();
                       if (entity_dim < 0 || entity_dim > 3)
                         words.fail("entity dimension " +
                                    std::to_string(entity_dim));
@@ -329,7 +339,7 @@ namespace knee_contact
                           // tag type n_tags tags...: the first tag is the
                           // physical group.
                           type                   = words.integer();
-                          const long long n_tags = words.integer();
+                          const long long n_tags = words.count();
                           id                     = 0;
                           for (long long k = 0; k < n_tags; ++k)
                             {
