@@ -6,6 +6,7 @@
 
 #include <deal.II/grid/grid_tools.h>
 
+#include <array>
 #include <charconv>
 #include <cstdint>
 #include <limits>
@@ -203,6 +204,237 @@ namespace knee_contact
               words.fail("element type " + std::to_string(type));
           }
       }
+
+
+      // A $Nodes or $Elements header: 4.1's 'blocks count smallest largest'
+      // tag, 2.2's 'count' (one block, tags from 1).
+      struct Header
+      {
+        long long n_blocks = 1, n = 0, smallest = 1, largest = 0;
+      };
+
+      Header
+      header(Words &words, const bool v4)
+      {
+        Header h;
+        if (v4)
+          {
+            h.n_blocks = words.count();
+            h.n        = words.count();
+            h.smallest = words.integer();
+            h.largest  = words.integer();
+          }
+        else
+          h.largest = h.n = words.count();
+        return h;
+      }
+
+
+
+      // The sections of a .msh text in the order GridIn reads them, into
+      // a description.
+      template <int dim>
+      class MshText
+      {
+      public:
+        MshText(const std::string_view text)
+          : words(text)
+        {
+          words.expect("$MeshFormat");
+          const std::string version(words.word());
+          v4 = version == "4.1";
+          if (!v4 && version != "2.2" && version != "2")
+            words.fail("format version " + version);
+          words.word();
+          words.word();
+          words.expect("$EndMeshFormat");
+          // GridIn stops after $Elements.
+          for (bool done = false; !done;)
+            {
+              const std::string_view section = words.word();
+              if (section == "$Entities" && v4)
+                entities();
+              else if (section == "$Nodes")
+                nodes();
+              else if (section == "$Elements")
+                {
+                  elements();
+                  done = true;
+                }
+              else if (section.size() > 1 && section[0] == '$')
+                words.skip_section(section.substr(1));
+              else
+                words.fail("'" + std::string(section) + "' outside a section");
+            }
+          if (mesh.cells.empty())
+            words.fail("no cells");
+        }
+
+        mesh_readers::Description<dim> mesh;
+        bool                           hypercubes = false, simplices = false;
+
+      private:
+        // 4.1: each entity's physical group (0 without, as in GridIn).
+        void
+        entities()
+        {
+          long long n[4];
+          for (auto &count : n)
+            count = words.count();
+          for (unsigned int d = 0; d < 4; ++d)
+            for (long long e = 0; e < n[d]; ++e)
+              {
+                const long long tag = words.integer();
+                for (unsigned int k = 0; k < (d == 0 ? 3 : 6); ++k)
+                  words.real();
+                const long long n_physical = words.count();
+                if (n_physical > 1)
+                  words.fail("entity " + std::to_string(tag) +
+                             " in several physical groups");
+                long long group = 0;
+                for (long long k = 0; k < n_physical; ++k)
+                  group = words.integer();
+                physical[d][tag] = group;
+                if (d > 0)
+                  for (long long k = words.count(); k > 0; --k)
+                    words.integer();
+              }
+          words.expect("$EndEntities");
+        }
+
+        void
+        nodes()
+        {
+          const Header h = header(words, v4);
+          node_index.reserve(h.smallest, h.largest, h.n);
+          mesh.vertices.reserve(h.n);
+          std::vector<long long> tags;
+          for (long long b = 0; b < h.n_blocks; ++b)
+            {
+              long long entity_dim = 0, parametric = 0, n = h.n;
+              if (v4)
+                {
+                  entity_dim = words.integer();
+                  words.integer();
+                  parametric = words.integer();
+                  n          = words.count();
+                  tags.resize(n);
+                  for (auto &tag : tags)
+                    tag = words.integer();
+                }
+              for (long long i = 0; i < n; ++i)
+                {
+                  const long long tag = v4 ? tags[i] : words.integer();
+                  double          x[3];
+                  for (double &x_d : x)
+                    x_d = words.real();
+                  // A parametric node's coordinates on its entity.
+                  for (long long k = 0; parametric != 0 && k < entity_dim; ++k)
+                    words.real();
+                  Point<dim> point;
+                  for (unsigned int d = 0; d < dim; ++d)
+                    point[d] = x[d];
+                  node_index.add(tag, mesh.vertices.size());
+                  mesh.vertices.push_back(point);
+                }
+            }
+          words.expect("$EndNodes");
+        }
+
+        void
+        elements()
+        {
+          const Header h = header(words, v4);
+          for (long long b = 0; b < h.n_blocks; ++b)
+            {
+              long long type = 0, n = h.n, id = 0;
+              if (v4)
+                {
+                  const long long entity_dim = words.integer();
+                  const long long entity     = words.integer();
+                  type                       = words.integer();
+                  n                          = words.count();
+                  if (entity_dim < 0 || entity_dim > 3)
+                    words.fail("entity dimension " +
+                               std::to_string(entity_dim));
+                  const auto it = physical[entity_dim].find(entity);
+                  id = it == physical[entity_dim].end() ? 0 : it->second;
+                }
+              for (long long i = 0; i < n; ++i)
+                {
+                  words.integer();
+                  if (!v4)
+                    {
+                      // type n_tags tags...: the first tag is the physical
+                      // group.
+                      type                   = words.integer();
+                      const long long n_tags = words.count();
+                      id                     = 0;
+                      for (long long k = 0; k < n_tags; ++k)
+                        {
+                          const long long tag = words.integer();
+                          if (k == 0)
+                            id = tag;
+                        }
+                    }
+                  element(type, id);
+                }
+            }
+          words.expect("$EndElements");
+        }
+
+        // An element's nodes: a cell of material @p id, or a boundary
+        // face (a line; in 3D a triangle or quadrilateral) of boundary
+        // id @p id.
+        void
+        element(const long long type, const long long id)
+        {
+          const unsigned int n_v = n_nodes(type, words);
+          unsigned int       v[8];
+          for (unsigned int k = 0; k < n_v; ++k)
+            v[k] = node_index(words.integer(), words);
+          const bool cell = (dim == 2 && (type == 2 || type == 3)) ||
+                            (dim == 3 && (type == 4 || type == 5));
+          const bool hypercube = type == 3 || type == 5;
+          if (cell)
+            {
+              (hypercube ? hypercubes : simplices) = true;
+              CellData<dim> data(n_v);
+              // deal.II numbers a quadrilateral's or a hexahedron's
+              // vertices lexicographically.
+              for (unsigned int k = 0; k < n_v; ++k)
+                data
+                  .vertices[hypercube ? GeometryInfo<dim>::ucd_to_deal[k] : k] =
+                  v[k];
+              data.material_id = static_cast<types::material_id>(id);
+              mesh.cells.push_back(std::move(data));
+            }
+          else if (type == 1)
+            {
+              CellData<1> line;
+              line.vertices    = {v[0], v[1]};
+              line.boundary_id = static_cast<types::boundary_id>(id);
+              mesh.subcells.boundary_lines.push_back(line);
+            }
+          else if (dim == 3 && (type == 2 || type == 3))
+            {
+              (hypercube ? hypercubes : simplices) = true;
+              CellData<2> face(n_v);
+              for (unsigned int k = 0; k < n_v; ++k)
+                face.vertices[k] = v[k];
+              face.boundary_id = static_cast<types::boundary_id>(id);
+              mesh.subcells.boundary_quads.push_back(std::move(face));
+            }
+          else if (type != 15)
+            words.fail("element type " + std::to_string(type) + " in a " +
+                       std::to_string(dim) + "D mesh");
+        }
+
+        Words                                                   words;
+        bool                                                    v4 = false;
+        std::array<std::unordered_map<long long, long long>, 4> physical;
+        NodeIndex                                               node_index;
+      };
     } // namespace
 
 
@@ -211,205 +443,13 @@ namespace knee_contact
     mesh_readers::Description<dim>
     read_msh(const std::string_view text)
     {
-      Words words(text);
-      words.expect("$MeshFormat");
-      const std::string version(words.word());
-      const bool        v4 = version == "4.1";
-      if (!v4 && version != "2.2" && version != "2")
-        words.fail("format version " + version);
-      words.word();
-      words.word();
-      words.expect("$EndMeshFormat");
-
-      // The physical tag of each entity (4.1), by dimension; an entity
-      // without one gives 0, as in GridIn.
-      std::array<std::unordered_map<long long, long long>, 4> physical;
-      NodeIndex                                               node_index;
-      mesh_readers::Description<dim>                          mesh;
-      bool hypercubes = false, simplices = false;
-      for (bool done = false; !done;)
-        {
-          const std::string_view section = words.word();
-          if (section == "$Entities" && v4)
-            {
-              long long n[4];
-              for (auto &count : n)
-                count = words.count();
-              for (unsigned int d = 0; d < 4; ++d)
-                for (long long e = 0; e < n[d]; ++e)
-                  {
-                    const long long tag = words.integer();
-                    for (unsigned int k = 0; k < (d == 0 ? 3 : 6); ++k)
-                      words.real();
-                    const long long n_physical = words.count();
-                    if (n_physical > 1)
-                      words.fail("entity " + std::to_string(tag) +
-                                 " in several physical groups");
-                    long long group = 0;
-                    for (long long k = 0; k < n_physical; ++k)
-                      group = words.integer();
-                    physical[d][tag] = group;
-                    if (d > 0)
-                      for (long long k = words.count(); k > 0; --k)
-                        words.integer();
-                  }
-              words.expect("$EndEntities");
-            }
-          else if (section == "$Nodes")
-            {
-              long long n_blocks = 1, n_total = 0;
-              if (v4)
-                {
-                  n_blocks              = words.count();
-                  n_total               = words.count();
-                  const long long first = words.integer();
-                  node_index.reserve(first, words.integer(), n_total);
-                }
-              else
-                {
-                  n_total = words.count();
-                  node_index.reserve(1, n_total, n_total);
-                }
-              mesh.vertices.reserve(n_total);
-              std::vector<long long> tags;
-              for (long long b = 0; b < n_blocks; ++b)
-                {
-                  long long entity_dim = 0, parametric = 0, n = n_total;
-                  if (v4)
-                    {
-                      entity_dim = words.integer();
-                      words.integer();
-                      parametric = words.integer();
-                      n          = words.count();
-                      tags.resize(n);
-                      for (auto &tag : tags)
-                        tag = words.integer();
-                    }
-                  for (long long i = 0; i < n; ++i)
-                    {
-                      const long long tag = v4 ? tags[i] : words.integer();
-                      double          x[3];
-                      for (double &x_d : x)
-                        x_d = words.real();
-                      // A parametric node's coordinates on its entity.
-                      for (long long k = 0; parametric != 0 && k < entity_dim;
-                           ++k)
-                        words.real();
-                      Point<dim> point;
-                      for (unsigned int d = 0; d < dim; ++d)
-                        point[d] = x[d];
-                      node_index.add(tag, mesh.vertices.size());
-                      mesh.vertices.push_back(point);
-                    }
-                }
-              words.expect("$EndNodes");
-            }
-          else if (section == "$Elements")
-            {
-              long long n_blocks = 1, n_total = 0;
-              if (v4)
-                {
-                  n_blocks = words.count();
-                  n_total  = words.count();
-                  words.integer();
-                  words.integer();
-                }
-              else
-                n_total = words.count();
-              for (long long b = 0; b < n_blocks; ++b)
-                {
-                  long long type = 0, n = n_total, id = 0;
-                  if (v4)
-                    {
-                      const long long entity_dim = words.integer();
-                      const long long entity     = words.integer();
-                      type                       = words.integer();
-                      n                          = words.count();
-                      if (entity_dim < 0 || entity_dim > 3)
-                        words.fail("entity dimension " +
-                                   std::to_string(entity_dim));
-                      const auto it = physical[entity_dim].find(entity);
-                      id = it == physical[entity_dim].end() ? 0 : it->second;
-                    }
-                  for (long long i = 0; i < n; ++i)
-                    {
-                      words.integer();
-                      if (!v4)
-                        {
-                          // tag type n_tags tags...: the first tag is the
-                          // physical group.
-                          type                   = words.integer();
-                          const long long n_tags = words.count();
-                          id                     = 0;
-                          for (long long k = 0; k < n_tags; ++k)
-                            {
-                              const long long tag = words.integer();
-                              if (k == 0)
-                                id = tag;
-                            }
-                        }
-                      const unsigned int n_v = n_nodes(type, words);
-                      unsigned int       v[8];
-                      for (unsigned int k = 0; k < n_v; ++k)
-                        v[k] = node_index(words.integer(), words);
-                      const bool cell =
-                        (dim == 2 && (type == 2 || type == 3)) ||
-                        (dim == 3 && (type == 4 || type == 5));
-                      const bool hypercube = type == 3 || type == 5;
-                      if (cell)
-                        {
-                          (hypercube ? hypercubes : simplices) = true;
-                          CellData<dim> data(n_v);
-                          // deal.II numbers a quadrilateral's or a
-                          // hexahedron's vertices lexicographically.
-                          for (unsigned int k = 0; k < n_v; ++k)
-                            data.vertices[hypercube
-                                            ? GeometryInfo<dim>::ucd_to_deal[k]
-                                            : k] = v[k];
-                          data.material_id =
-                            static_cast<types::material_id>(id);
-                          mesh.cells.push_back(std::move(data));
-                        }
-                      else if (type == 1)
-                        {
-                          CellData<1> line;
-                          line.vertices = {v[0], v[1]};
-                          line.boundary_id =
-                            static_cast<types::boundary_id>(id);
-                          mesh.subcells.boundary_lines.push_back(line);
-                        }
-                      else if (dim == 3 && (type == 2 || type == 3))
-                        {
-                          (hypercube ? hypercubes : simplices) = true;
-                          CellData<2> face(n_v);
-                          for (unsigned int k = 0; k < n_v; ++k)
-                            face.vertices[k] = v[k];
-                          face.boundary_id =
-                            static_cast<types::boundary_id>(id);
-                          mesh.subcells.boundary_quads.push_back(
-                            std::move(face));
-                        }
-                      else if (type != 15)
-                        words.fail("element type " + std::to_string(type) +
-                                   " in a " + std::to_string(dim) + "D mesh");
-                    }
-                }
-              words.expect("$EndElements");
-              done = true;
-            }
-          else if (section.size() > 1 && section[0] == '$')
-            words.skip_section(section.substr(1));
-          else
-            words.fail("'" + std::string(section) + "' outside a section");
-        }
-      if (mesh.cells.empty())
-        words.fail("no cells");
-
+      MshText<dim> read(text);
+      auto        &mesh = read.mesh;
       // GridIn's clean-up before it makes the triangulation, in its order:
       // a mesh of quadrilaterals or hexahedra only loses its unused
       // vertices and has its cells ordered consistently; cells turned
       // inside out are turned over.
-      if (hypercubes && !simplices)
+      if (read.hypercubes && !read.simplices)
         {
           GridTools::delete_unused_vertices(mesh.vertices,
                                             mesh.cells,
@@ -418,10 +458,10 @@ namespace knee_contact
                                                         mesh.cells);
           GridTools::consistently_order_cells(mesh.cells);
         }
-      else if (simplices)
+      else if (read.simplices)
         GridTools::invert_cells_with_negative_measure(mesh.vertices,
                                                       mesh.cells);
-      return mesh;
+      return std::move(mesh);
     }
 
 

@@ -163,61 +163,70 @@ namespace
   }
 } // namespace
 
+namespace
+{
+  // A mesh gmsh makes of a .geo: its name, dimension, file and arguments.
+  struct Case
+  {
+    std::string              name;
+    int                      dim;
+    std::string              geo;
+    std::vector<std::string> arguments;
+  };
+} // namespace
+
 int
 main()
 {
   std::filesystem::remove_all(folder);
   std::filesystem::create_directories(folder);
-  const std::string meshes = SOURCE_DIR "/../meshes/";
-  const std::string prm    = SOURCE_DIR "/../../prm/";
+  const std::string       meshes = SOURCE_DIR "/../meshes/";
+  const std::string       prm    = SOURCE_DIR "/../../prm/";
+  const std::vector<Case> cases  = {
+     {"triangles (patch stack, two bodies)", 2, meshes + "patch_stack", {}},
+     {"quadrilaterals (Hertz, two bodies)", 2, prm + "hertz", {"-clscale", "4"}},
+     {"quadrilaterals (knee, sagittal)", 2, prm + "knee", {"-clscale", "4"}},
+     {"hexahedra (block, two materials)",
+      3,
+      meshes + "block",
+      {"-setnumber", "two", "1"}},
+     {"tetrahedra (cube)",
+      3,
+      meshes + "cube",
+      {"-setnumber", "hex", "0", "-setnumber", "n", "3"}},
+     {"tetrahedra (sphere octant, curved)", 3, meshes + "sphere_octant", {}},
+     {"hexahedra on tetrahedra (contact stack)",
+      3,
+      meshes + "contact_stack_3d",
+      {"-setnumber",
+       "hex_upper",
+       "0",
+       "-setnumber",
+       "n_lower",
+       "2",
+       "-setnumber",
+       "n_upper",
+       "3"}}};
   for (const std::string format : {"msh22", "msh41"})
-    {
-      const std::vector<std::string> f    = {"-format", format};
-      const auto                     with = [&](std::vector<std::string> more) {
-        more.insert(more.end(), f.begin(), f.end());
-        return more;
-      };
-      compare<2>(format + " triangles (patch stack, two bodies)",
-                 mesh(meshes + "patch_stack.geo",
-                      with({"-2"}),
-                      "patch_" + format + ".msh"));
-      compare<2>(format + " quadrilaterals (Hertz, two bodies)",
-                 mesh(prm + "hertz.geo",
-                      with({"-2", "-clscale", "4"}),
-                      "hertz_" + format + ".msh"));
-      compare<2>(format + " quadrilaterals (knee, sagittal)",
-                 mesh(prm + "knee.geo",
-                      with({"-2", "-clscale", "4"}),
-                      "knee_" + format + ".msh"));
-      compare<3>(format + " hexahedra (block, two materials)",
-                 mesh(meshes + "block.geo",
-                      with({"-3", "-setnumber", "two", "1"}),
-                      "block_" + format + ".msh"));
-      compare<3>(
-        format + " tetrahedra (cube)",
-        mesh(meshes + "cube.geo",
-             with({"-3", "-setnumber", "hex", "0", "-setnumber", "n", "3"}),
-             "cube_" + format + ".msh"));
-      compare<3>(format + " tetrahedra (sphere octant, curved)",
-                 mesh(meshes + "sphere_octant.geo",
-                      with({"-3"}),
-                      "octant_" + format + ".msh"));
-      compare<3>(format + " hexahedra on tetrahedra (contact stack)",
-                 mesh(meshes + "contact_stack_3d.geo",
-                      with({"-3",
-                            "-setnumber",
-                            "hex_upper",
-                            "0",
-                            "-setnumber",
-                            "n_lower",
-                            "2",
-                            "-setnumber",
-                            "n_upper",
-                            "3"}),
-                      "stack_" + format + ".msh"));
-    }
+    for (const Case &c : cases)
+      {
+        std::vector<std::string> arguments = {c.dim == 2 ? "-2" : "-3",
+                                              "-format",
+                                              format};
+        arguments.insert(arguments.end(),
+                         c.arguments.begin(),
+                         c.arguments.end());
+        const std::string stem =
+          std::filesystem::path(c.geo).filename().string();
+        const std::string msh =
+          mesh(c.geo + ".geo", arguments, stem + "_" + format + ".msh");
+        if (c.dim == 2)
+          compare<2>(format + " " + c.name, msh);
+        else
+          compare<3>(format + " " + c.name, msh);
+      }
   compare<2>("msh22 triangles, sparse and negative node tags",
-             sparse_tags(folder + "/patch_msh22.msh"));
+             sparse_tags(folder + "/patch_stack_msh22.msh"));
   compare<3>("msh22 hexahedra, sparse and negative node tags",
              sparse_tags(folder + "/block_msh22.msh"));
   compare<2>("msh22 file of the uniaxial block scene",
@@ -226,7 +235,7 @@ main()
              SOURCE_DIR "/../scenes/uniaxial_block_msh41.msh");
 
   // Parametric coordinates: the same triangulation as without.
-  const std::string plain      = folder + "/octant_msh41.msh";
+  const std::string plain      = folder + "/sphere_octant_msh41.msh";
   const std::string parametric = mesh(meshes + "sphere_octant.geo",
                                       {"-3", "-format", "msh41", "-parametric"},
                                       "octant_parametric.msh");
