@@ -308,9 +308,9 @@ namespace knee_contact
       part = part_of(0);
     descriptions.reset();
     // Rank 0 lets go of the whole mesh before it makes its part, so that
-    // it never holds both: the whole mesh and its part at once were its
-    // peak on four ranks at 1e6 DoFs (doc/parallel.md, "The whole mesh
-    // gone before rank 0's part").
+    // it never holds both: its mesh phase's peak at 1e6 DoFs on two ranks
+    // 1 623 -> 1 486 MB (doc/parallel.md, "The mesh read without GridIn's
+    // stream").
     if (first)
       whole.clear();
     // On the other ranks: waiting for its description.

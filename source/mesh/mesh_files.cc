@@ -320,7 +320,7 @@ namespace knee_contact
     mesh_readers::Description<dim> mesh;
     if (extension == ".msh" || extension == ".geo")
       {
-        // deal.II's reader makes the triangulation; most Gmsh meshes are
+        // read_gmsh() makes the triangulation; most Gmsh meshes are
         // ready as read. Only cells to turn over or to split need the
         // description (a second triangulation took 6.3 of the 22 s of
         // reading a mesh of 1.5e6 tetrahedra).
