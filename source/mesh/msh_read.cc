@@ -8,8 +8,6 @@
 
 #include <array>
 #include <charconv>
-#include <cstdint>
-#include <limits>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -206,8 +204,8 @@ namespace knee_contact
       }
 
 
-      // A $Nodes or $Elements header: 4.1's 'blocks count smallest largest'
-      // tag, 2.2's 'count' (one block, tags from 1).
+      // A $Nodes or $Elements header: 4.1's 'blocks count smallest-tag
+      // largest-tag', 2.2's 'count' (one block, tags from 1).
       struct Header
       {
         long long n_blocks = 1, n = 0, smallest = 1, largest = 0;
