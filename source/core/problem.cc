@@ -472,9 +472,6 @@ namespace knee_contact
         simplex ? ReferenceCells::get_simplex<dim>()
                 : ReferenceCells::get_hypercube<dim>());
     distributed = std::make_unique<DistributedMesh<dim>>();
-    // distribute_mesh() clears rank 0's whole mesh: the DoF handler lets
-    // go of it first.
-    dof_handler.reinit(distributed->triangulation);
     distribute_mesh(triangulation, body_of_cell, n_bodies, *distributed);
     dof_handler.reinit(distributed->triangulation);
     triangulation.clear();

@@ -260,38 +260,22 @@ namespace knee_contact
 
 
 
-      // Nodes and dimension of the element types deal.II reads (linear
-      // ones; wedges and pyramids have no element here).
+      // element_kind(), or the failure that names what is not supported.
       std::pair<unsigned int, unsigned int>
       nodes_and_dimension(const long long type, const MshReader &reader)
       {
-        switch (type)
-          {
-            case 15:
-              return {1, 0};
-            case 1:
-              return {2, 1};
-            case 2:
-              return {3, 2};
-            case 3:
-              return {4, 2};
-            case 4:
-              return {4, 3};
-            case 5:
-              return {8, 3};
-            case 6:
-            case 7:
-              reader.fail(
-                std::string(type == 6 ? "wedges (prisms)" : "pyramids") +
-                " (element type " + std::to_string(type) +
-                ") are not supported; mesh the volumes with "
-                "tetrahedra (4) or hexahedra (5) only");
-            default:
-              reader.fail("element type " + std::to_string(type) +
-                          " is not supported (points 15, lines 1, triangles "
-                          "2, quadrilaterals 3, tetrahedra 4, hexahedra 5; "
-                          "linear elements only)");
-          }
+        const auto kind = element_kind(type);
+        if (kind.first > 0)
+          return kind;
+        if (type == 6 || type == 7)
+          reader.fail(std::string(type == 6 ? "wedges (prisms)" : "pyramids") +
+                      " (element type " + std::to_string(type) +
+                      ") are not supported; mesh the volumes with "
+                      "tetrahedra (4) or hexahedra (5) only");
+        reader.fail("element type " + std::to_string(type) +
+                    " is not supported (points 15, lines 1, triangles "
+                    "2, quadrilaterals 3, tetrahedra 4, hexahedra 5; "
+                    "linear elements only)");
       }
 
       // The cells' dimension (the highest element dimension). Tetrahedra
@@ -540,6 +524,30 @@ namespace knee_contact
         return kinds.dimension;
       }
     } // namespace
+
+
+
+    std::pair<unsigned int, unsigned int>
+    element_kind(const long long type)
+    {
+      switch (type)
+        {
+          case 15:
+            return {1, 0};
+          case 1:
+            return {2, 1};
+          case 2:
+            return {3, 2};
+          case 3:
+            return {4, 2};
+          case 4:
+            return {4, 3};
+          case 5:
+            return {8, 3};
+          default:
+            return {0, 0};
+        }
+    }
 
 
 

@@ -181,29 +181,6 @@ namespace knee_contact
 
 
 
-      // Nodes of an element of Gmsh type @p type (check_msh() admits these).
-      unsigned int
-      n_nodes(const long long type, const Words &words)
-      {
-        switch (type)
-          {
-            case 15:
-              return 1;
-            case 1:
-              return 2;
-            case 2:
-              return 3;
-            case 3:
-            case 4:
-              return 4;
-            case 5:
-              return 8;
-            default:
-              words.fail("element type " + std::to_string(type));
-          }
-      }
-
-
       // A $Nodes or $Elements header: 4.1's 'blocks count smallest-tag
       // largest-tag', 2.2's 'count' (one block, tags from 1).
       struct Header
@@ -387,8 +364,10 @@ namespace knee_contact
         void
         element(const long long type, const long long id)
         {
-          const unsigned int n_v = n_nodes(type, words);
-          unsigned int       v[8];
+          const unsigned int n_v = element_kind(type).first;
+          if (n_v == 0)
+            words.fail("element type " + std::to_string(type));
+          unsigned int v[8];
           for (unsigned int k = 0; k < n_v; ++k)
             v[k] = node_index(words.integer(), words);
           const bool cell = (dim == 2 && (type == 2 || type == 3)) ||

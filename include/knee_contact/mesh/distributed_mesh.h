@@ -103,9 +103,9 @@ namespace knee_contact
    * layer and the coarse cells they descend from, with material, boundary
    * and manifold ids) and sends it; every rank makes its part of the mesh
    * from it. Rank 0's @p whole is cleared once the descriptions are made,
-   * before its part is (nothing may hold it: a DoFHandler on it is
-   * reinitialised first); the other ranks' @p whole and
-   * @p whole_body_of_cell are not read. A collective call.
+   * before its part is (a DoFHandler on it clears itself with it); the
+   * other ranks' @p whole and @p whole_body_of_cell are not read. A
+   * collective call.
    */
   template <int dim>
   void

@@ -6,6 +6,7 @@
 #include <set>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace knee_contact
@@ -90,6 +91,15 @@ namespace knee_contact
      */
     unsigned int
     check_msh(const std::string &file);
+
+    /**
+     * The nodes and the dimension of a Gmsh element of @p type, for the
+     * types deal.II reads (linear ones: points 15, lines 1, triangles 2,
+     * quadrilaterals 3, tetrahedra 4, hexahedra 5); {0, 0} for any other.
+     * check_msh() and read_msh() share it.
+     */
+    std::pair<unsigned int, unsigned int>
+    element_kind(const long long type);
 
     /**
      * The vertices, cells and boundary faces of the ASCII .msh text
