@@ -16,6 +16,16 @@ difference of the contact forces and peak pressures from the one-process
 run. Times are the median over --repeat runs; the ratios are of medians
 measured in this one invocation (the machine is noisy).
 
+With --repeat R > 1 the runs go in R rounds, each round one run of every
+N (1, 2, 4, 1, 2, 4, ...), so that a slow hour of the machine slows every
+N alike, and before and after every run a probe times a fixed
+memory-bound kernel on both cores at once (two processes, each a triad
+over 3 x 160 MB): a table of the rounds gives each run beside the slower
+of its two probes, the ratios of the
+first N's run to the others' in the round, and their median over the
+rounds, over every round and over the rounds whose probes were all
+within 10 % of the fastest probe (the machine at its own speed).
+
 --model (ranks 1 and 2 needed) fits scaling_model.py's constants to the
 N = 1 and N = 2 runs, prints its prediction beside each measured N (N = 4
 on this 2-core machine checks its oversubscription and communication
@@ -56,6 +66,55 @@ def run(binary, scene_text, folder, ranks):
                  (scene, ranks, result.returncode, result.stderr[-2000:]))
     with open(os.path.join(folder, "summary.json")) as f:
         return json.load(f), seconds
+
+
+PROBE = """
+import numpy, time
+b = numpy.ones(20000000); c = numpy.ones(20000000); a = numpy.empty_like(b)
+a[:] = b + 3.0 * c
+start = time.monotonic()
+for _ in range(20):
+    numpy.multiply(c, 3.0, out=a)
+    numpy.add(a, b, out=a)
+print(time.monotonic() - start)
+"""
+
+
+def probe():
+    """Seconds of the probe (PROBE) on both cores at once: the slower of
+    two processes started together (numpy from Debian's Python)."""
+    workers = [subprocess.Popen(["/usr/bin/python3", "-c", PROBE],
+                                stdout=subprocess.PIPE, text=True)
+               for _ in range(2)]
+    return max(float(worker.communicate()[0]) for worker in workers)
+
+
+def print_rounds(ranks, rounds):
+    """Each round's runs and probes, the ratios of the first N's run to
+    the others', and their medians (all rounds; the quiet ones)."""
+    fastest = min(p for r in rounds for _, p in r.values())
+    print("\n| round | " + " | ".join(
+        "N = %d: run [s] (probe [s])" % n for n in ranks) + " | " +
+        " | ".join("ratio %d / %d" % (ranks[0], n) for n in ranks[1:]) +
+        " | quiet |")
+    print("|" + "---|" * (2 * len(ranks) + 1))
+    ratios, quiet = [], []
+    for k, r in enumerate(rounds):
+        row = [r[n][0] and r[ranks[0]][0] / r[n][0] for n in ranks[1:]]
+        calm = all(p <= 1.1 * fastest for _, p in r.values())
+        ratios.append(row)
+        if calm:
+            quiet.append(row)
+        print("| %d | %s | %s | %s |" % (
+            k + 1, " | ".join("%.1f (%.2f)" % r[n] for n in ranks),
+            " | ".join("%.2f" % x for x in row), "yes" if calm else "no"))
+    for name, chosen in (("every round", ratios), ("quiet rounds", quiet)):
+        if chosen:
+            print("median ratio over %s (%d): %s" % (
+                name, len(chosen), ", ".join(
+                    "%d / %d %.2f" % (ranks[0], n, statistics.median(
+                        row[i] for row in chosen))
+                    for i, n in enumerate(ranks[1:]))))
 
 
 def contact_numbers(summary):
@@ -118,11 +177,23 @@ def main():
     text = scene_text(scene, args.solver)
     stem = os.path.splitext(os.path.basename(scene))[0]
 
+    # Rounds of one run of every N (see the docstring).
+    by_ranks = {ranks: [] for ranks in args.ranks}
+    rounds = []
+    before = probe() if args.repeat > 1 else 0.
+    for k in range(args.repeat):
+        rounds.append({})
+        for ranks in args.ranks:
+            by_ranks[ranks].append(run(binary, text, os.path.abspath(
+                os.path.join("output", "scaling", "%s_%d_%d" % (
+                    stem, ranks, k))), ranks))
+            after = probe() if args.repeat > 1 else 0.
+            rounds[-1][ranks] = (by_ranks[ranks][-1][1], max(before, after))
+            before = after
+
     rows, reference = [], None
     for ranks in args.ranks:
-        runs = [run(binary, text, os.path.abspath(os.path.join(
-            "output", "scaling", "%s_%d_%d" % (stem, ranks, k))), ranks)
-            for k in range(args.repeat)]
+        runs = by_ranks[ranks]
         summaries = [summary for summary, _ in runs]
 
         def median(read):
@@ -176,6 +247,8 @@ def main():
                   base["run"] / row["run"],
                   base["solve"] / max(row["solve"], 1e-9), row["estimate"],
                   row["path_measured"], row["peak"], row["difference"]))
+    if args.repeat > 1:
+        print_rounds(args.ranks, rounds)
     if args.model:
         # The program's own memory (its libraries): a scene of a few cells.
         tiny, _ = run(binary, scene_text(os.path.join(

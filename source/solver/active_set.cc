@@ -3,6 +3,8 @@
 #include <knee_contact/solver/active_set.h>
 #include <knee_contact/solver/row_multipliers.h>
 
+#include <deal.II/base/mpi.h>
+
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 #include <deal.II/lac/sparsity_pattern.h>
 #include <deal.II/lac/trilinos_sparsity_pattern.h>
@@ -374,11 +376,20 @@ namespace knee_contact
     const bool                                    cycles_allowed,
     const std::vector<std::vector<unsigned int>> &spring_rows)
   {
-    // Each rank expands its rows of the mesh's pattern; a row of another
-    // rank's a line's expansion reaches is sent to it by compress()
-    // (Epetra's FE graph keeps rows it does not own until then).
+    // Each rank expands its rows of the mesh's pattern into a pattern of
+    // its own rows; a row of another rank that a line's expansion reaches
+    // is sent to its owner here, so that Epetra's graph is made from owned
+    // rows alone. Given such rows itself, Epetra's FE graph sends them in
+    // its GlobalAssemble() and keeps that export's buffers as long as the
+    // graph lives: 21 of the 35 MB a rank's pattern held at 2.3e5 dofs on
+    // four ranks (heaptrack, doc/parallel.md), through every solve.
+    const MPI_Comm comm  = mesh_pattern.get_mpi_communicator();
     const IndexSet owned = mesh_pattern.locally_owned_range_indices();
-    sparsity_pattern.reinit(owned, owned, mesh_pattern.get_mpi_communicator());
+    // (deal.II makes Epetra's graph from a pattern of one range of rows.)
+    AssertThrow(owned.is_contiguous(), ExcInternalError());
+    DynamicSparsityPattern mine(owned.size(), owned.size(), owned);
+    std::map<types::global_dof_index, std::vector<types::global_dof_index>>
+                           others;
     const Epetra_CrsGraph &graph = mesh_pattern.trilinos_sparsity_pattern();
     std::vector<types::global_dof_index> columns;
     expand_pattern(
@@ -397,14 +408,47 @@ namespace knee_contact
       },
       [&](const types::global_dof_index               a,
           const std::vector<types::global_dof_index> &sorted) {
-        sparsity_pattern.add_entries(a, sorted.begin(), sorted.end(), true);
+        if (owned.is_element(a))
+          mine.add_entries(a, sorted.begin(), sorted.end(), true);
+        else
+          {
+            auto &row = others[a];
+            row.insert(row.end(), sorted.begin(), sorted.end());
+          }
       },
       [&](const types::global_dof_index a) { return owned.is_element(a); },
       base,
       pairs,
       cycles_allowed,
       spring_rows);
-    sparsity_pattern.compress();
+
+    // Each other row to its owner, as (row, length, columns...).
+    const std::vector<IndexSet> owned_by =
+      Utilities::MPI::all_gather(comm, owned);
+    std::map<unsigned int, std::vector<types::global_dof_index>> sent;
+    for (auto &[row, cols] : others)
+      {
+        std::sort(cols.begin(), cols.end());
+        cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
+        const auto owner =
+          std::find_if(owned_by.begin(), owned_by.end(), [&](const auto &set) {
+            return set.is_element(row);
+          });
+        AssertThrow(owner != owned_by.end(), ExcInternalError());
+        auto &message = sent[owner - owned_by.begin()];
+        message.push_back(row);
+        message.push_back(cols.size());
+        message.insert(message.end(), cols.begin(), cols.end());
+      }
+    others.clear();
+    for (const auto &[from, message] : Utilities::MPI::some_to_some(comm, sent))
+      for (std::size_t k = 0; k < message.size(); k += 2 + message[k + 1])
+        mine.add_entries(message[k],
+                         message.begin() + k + 2,
+                         message.begin() + k + 2 + message[k + 1],
+                         true);
+    sent.clear();
+    sparsity_pattern.reinit(owned, owned, mine, comm, false);
   }
 
 
