@@ -12,6 +12,9 @@
 #include <metis.h>
 
 #include <algorithm>
+#include <bitset>
+#include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <new>
@@ -99,6 +102,58 @@ namespace knee_contact
         cell->set_subdomain_id(part[cell->active_cell_index()]);
     }
   } // namespace
+
+
+
+  template <int dim>
+  void
+  PartTriangulation<dim>::create_triangulation(
+    const TriangulationDescription::Description<dim, dim> &description)
+  {
+    const std::vector<types::coarse_cell_id> &ids =
+      description.coarse_cell_index_to_coarse_cell_id;
+    AssertThrow(std::adjacent_find(ids.begin(),
+                                   ids.end(),
+                                   std::greater_equal<>()) == ids.end(),
+                ExcMessage("a mesh part's coarse cells are not in increasing "
+                           "order of their ids"));
+    dummy    = ids.empty();
+    first_id = ids.empty() ? 0 : ids.front();
+    const std::size_t n_words =
+      ids.empty() ? 0 : (ids.back() - first_id) / 64 + 1;
+    id_bits.assign(n_words, 0);
+    ids_before.assign(n_words, 0);
+    for (const types::coarse_cell_id id : ids)
+      id_bits[(id - first_id) / 64] |= std::uint64_t(1)
+                                       << ((id - first_id) % 64);
+    for (std::size_t w = 1; w < n_words; ++w)
+      ids_before[w] =
+        ids_before[w - 1] + std::bitset<64>(id_bits[w - 1]).count();
+    dealii::parallel::fullydistributed::Triangulation<
+      dim>::create_triangulation(description);
+  }
+
+
+
+  template <int dim>
+  unsigned int
+  PartTriangulation<dim>::coarse_cell_id_to_coarse_cell_index(
+    const types::coarse_cell_id id) const
+  {
+    // deal.II's dummy cell of a rank without cells has the invalid id.
+    if (dummy)
+      return id == numbers::invalid_coarse_cell_id
+               ? 0
+               : numbers::invalid_unsigned_int;
+    if (id < first_id || (id - first_id) / 64 >= id_bits.size())
+      return numbers::invalid_unsigned_int;
+    const std::uint64_t word = id_bits[(id - first_id) / 64];
+    const unsigned int  bit  = (id - first_id) % 64;
+    if ((word >> bit & 1) == 0)
+      return numbers::invalid_unsigned_int;
+    return ids_before[(id - first_id) / 64] +
+           std::bitset<64>(word & ((std::uint64_t(1) << bit) - 1)).count();
+  }
 
 
 
@@ -372,6 +427,8 @@ namespace knee_contact
 
 
 
+  template class PartTriangulation<2>;
+  template class PartTriangulation<3>;
   template class PartDescriptions<2>;
   template class PartDescriptions<3>;
   template struct DistributedMesh<2>;

@@ -295,6 +295,41 @@ namespace
     return true;
   }
 
+  /**
+   * Whether PartTriangulation (constant-time lookup of a coarse cell by
+   * its id) made from this rank's @p description has the cells, ids and
+   * subdomains of deal.II's fully distributed triangulation (binary search)
+   * made from it, and finds every cell from its id as deal.II's does. A
+   * collective call.
+   */
+  template <int dim>
+  bool
+  same_part(const TriangulationDescription::Description<dim, dim> &description)
+  {
+    dealii::parallel::fullydistributed::Triangulation<dim> reference(
+      description.comm);
+    reference.create_triangulation(description);
+    PartTriangulation<dim> ours(description.comm);
+    ours.create_triangulation(description);
+    bool same = reference.n_active_cells() == ours.n_active_cells() &&
+                reference.n_cells(0) == ours.n_cells(0);
+    auto a = reference.begin_active();
+    auto b = ours.begin_active();
+    for (; same && a != reference.end(); ++a, ++b)
+      {
+        same &= a->index() == b->index() &&
+                a->is_artificial() == b->is_artificial() &&
+                a->subdomain_id() == b->subdomain_id();
+        if (same && !a->is_artificial())
+          same &= a->id() == b->id() &&
+                  ours.create_cell_iterator(a->id()) == b &&
+                  reference.create_cell_iterator(a->id()) == a;
+      }
+    return same;
+  }
+
+
+
   template <int dim>
   void
   check_descriptions(const bool simplex)
@@ -312,7 +347,7 @@ namespace
         if (dim == 3 && cell->index() % 3 == 2)
           cell->line(1)->set_manifold_id(5);
       }
-    bool same = true;
+    bool same = true, lookup = true;
     for (unsigned int partition = 0; partition < 2; ++partition)
       {
         for (const auto &cell : whole.active_cell_iterators())
@@ -337,12 +372,18 @@ namespace
               same &= whole.get_vertices()[vertex_ids[v]] ==
                       mine.coarse_cell_vertices[v];
           }
+        std::vector<unsigned int> vertex_ids;
+        lookup &= same_part(descriptions.description(
+          knee_contact::parallel::rank(), comm, vertex_ids));
       }
+    lookup = Utilities::MPI::min(int(lookup), comm) == 1;
     if (knee_contact::parallel::rank() == 0)
       std::cout << dim << "D " << (simplex ? "simplex" : "hypercube")
                 << ": every rank's description that of deal.II (2 "
                    "partitions) "
-                << (same ? "yes" : "NO") << std::endl;
+                << (same ? "yes" : "NO")
+                << ", its part's cells found by id as deal.II finds them "
+                << (lookup ? "yes" : "NO") << std::endl;
   }
 
   void

@@ -8,6 +8,7 @@
 #include <deal.II/grid/tria.h>
 #include <deal.II/grid/tria_description.h>
 
+#include <cstdint>
 #include <map>
 #include <string>
 #include <vector>
@@ -15,6 +16,47 @@
 namespace knee_contact
 {
   using namespace dealii;
+
+  /**
+   * deal.II's parallel::fullydistributed::Triangulation, with a coarse
+   * cell's index found from its id in constant time. deal.II 9.4 finds it
+   * by a binary search of the rank's (id, index) pairs, and its
+   * create_triangulation() sorts the description's cells twice with two
+   * such searches per comparison (CellId::to_cell() makes one each): perf
+   * of rank 1 over the first 45 s of the 1e6-DoF knee on two ranks put 31 %
+   * of its samples (5.9 s) in that search (doc/parallel.md, "The coarse
+   * cells' ids found in constant time"). Here the ids' set is a bitmap over
+   * their range with the count of ids before each 64-bit word: the index of
+   * an id is that count plus the set bits below it in its word, 12 bytes
+   * per 64 ids of the range (a hash map would take about 40 bytes per id).
+   * Made only from descriptions whose coarse cells are in increasing id
+   * order, as PartDescriptions makes them (checked).
+   */
+  template <int dim>
+  class PartTriangulation
+    : public dealii::parallel::fullydistributed::Triangulation<dim>
+  {
+  public:
+    using dealii::parallel::fullydistributed::Triangulation<dim>::Triangulation;
+
+    void
+    create_triangulation(const TriangulationDescription::Description<dim, dim>
+                           &description) override;
+
+  private:
+    unsigned int
+    coarse_cell_id_to_coarse_cell_index(
+      const types::coarse_cell_id coarse_cell_id) const override;
+
+    /** The smallest id of this rank's coarse cells. */
+    types::coarse_cell_id first_id = 0;
+    /** Bit b of word w: the id first_id + 64 w + b is one of this rank's. */
+    std::vector<std::uint64_t> id_bits;
+    /** The number of this rank's ids below word w's. */
+    std::vector<unsigned int> ids_before;
+    /** deal.II's one dummy cell of a rank without cells (its id invalid). */
+    bool dummy = false;
+  };
 
   /**
    * A mesh divided over the ranks of a parallel run (issue 38's distributed
@@ -33,7 +75,7 @@ namespace knee_contact
     /** On the run's ranks (parallel::communicator()). */
     DistributedMesh();
 
-    dealii::parallel::fullydistributed::Triangulation<dim> triangulation;
+    PartTriangulation<dim> triangulation;
     /**
      * The body of each cell this rank holds (owned or ghost), by
      * active_cell_index(): the numbering of the whole mesh's
