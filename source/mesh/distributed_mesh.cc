@@ -117,7 +117,6 @@ namespace knee_contact
                                    std::greater_equal<>()) == ids.end(),
                 ExcMessage("a mesh part's coarse cells are not in increasing "
                            "order of their ids"));
-    dummy    = ids.empty();
     first_id = ids.empty() ? 0 : ids.front();
     const std::size_t n_words =
       ids.empty() ? 0 : (ids.back() - first_id) / 64 + 1;
@@ -140,19 +139,20 @@ namespace knee_contact
   PartTriangulation<dim>::coarse_cell_id_to_coarse_cell_index(
     const types::coarse_cell_id id) const
   {
-    // deal.II's dummy cell of a rank without cells has the invalid id.
-    if (dummy)
+    // A rank without cells holds deal.II's one dummy cell, of the invalid
+    // id.
+    if (id_bits.empty())
       return id == numbers::invalid_coarse_cell_id
                ? 0
                : numbers::invalid_unsigned_int;
     if (id < first_id || (id - first_id) / 64 >= id_bits.size())
       return numbers::invalid_unsigned_int;
-    const std::uint64_t word = id_bits[(id - first_id) / 64];
-    const unsigned int  bit  = (id - first_id) % 64;
-    if ((word >> bit & 1) == 0)
+    const std::size_t   w     = (id - first_id) / 64;
+    const unsigned int  bit   = (id - first_id) % 64;
+    const std::uint64_t below = id_bits[w] & ((std::uint64_t(1) << bit) - 1);
+    if ((id_bits[w] >> bit & 1) == 0)
       return numbers::invalid_unsigned_int;
-    return ids_before[(id - first_id) / 64] +
-           std::bitset<64>(word & ((std::uint64_t(1) << bit) - 1)).count();
+    return ids_before[w] + std::bitset<64>(below).count();
   }
 
 

@@ -24,13 +24,13 @@ namespace knee_contact
    * create_triangulation() sorts the description's cells twice with two
    * such searches per comparison (CellId::to_cell() makes one each): perf
    * of rank 1 over the first 45 s of the 1e6-DoF knee on two ranks put 31 %
-   * of its samples (5.9 s) in that search (doc/parallel.md, "The coarse
-   * cells' ids found in constant time"). Here the ids' set is a bitmap over
-   * their range with the count of ids before each 64-bit word: the index of
-   * an id is that count plus the set bits below it in its word, 12 bytes
-   * per 64 ids of the range (a hash map would take about 40 bytes per id).
-   * Made only from descriptions whose coarse cells are in increasing id
-   * order, as PartDescriptions makes them (checked).
+   * of its samples (5.9 s) in that search (doc/parallel.md, "Two ranks
+   * against one process in interleaved rounds"). Here the ids' set is a bitmap
+   * over their range with the count of ids before each 64-bit word: the index
+   * of an id is that count plus the set bits below it in its word, 12 bytes per
+   * 64 ids of the range (a hash map would take about 40 bytes per id). Made
+   * only from descriptions whose coarse cells are in increasing id order, as
+   * PartDescriptions makes them (checked).
    */
   template <int dim>
   class PartTriangulation
@@ -52,10 +52,9 @@ namespace knee_contact
     types::coarse_cell_id first_id = 0;
     /** Bit b of word w: the id first_id + 64 w + b is one of this rank's. */
     std::vector<std::uint64_t> id_bits;
-    /** The number of this rank's ids below word w's. */
+    /** The number of this rank's ids below word w's (both empty on a rank
+     * without cells). */
     std::vector<unsigned int> ids_before;
-    /** deal.II's one dummy cell of a rank without cells (its id invalid). */
-    bool dummy = false;
   };
 
   /**
