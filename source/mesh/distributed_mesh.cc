@@ -147,12 +147,11 @@ namespace knee_contact
                : numbers::invalid_unsigned_int;
     if (id < first_id || (id - first_id) / 64 >= id_bits.size())
       return numbers::invalid_unsigned_int;
-    const std::size_t   w     = (id - first_id) / 64;
-    const unsigned int  bit   = (id - first_id) % 64;
-    const std::uint64_t below = id_bits[w] & ((std::uint64_t(1) << bit) - 1);
-    if ((id_bits[w] >> bit & 1) == 0)
+    const std::size_t   w    = (id - first_id) / 64;
+    const std::uint64_t mask = std::uint64_t(1) << ((id - first_id) % 64);
+    if ((id_bits[w] & mask) == 0)
       return numbers::invalid_unsigned_int;
-    return ids_before[w] + std::bitset<64>(below).count();
+    return ids_before[w] + std::bitset<64>(id_bits[w] & (mask - 1)).count();
   }
 
 
