@@ -72,7 +72,7 @@ main(int argc, char **argv)
   n_bodies = Utilities::MPI::broadcast(comm, n_bodies, 0);
   say("whole mesh read on rank 0");
   DistributedMesh<3> mesh;
-  distribute_mesh(whole, bodies, n_bodies, mesh);
+  distribute_mesh(whole, bodies, n_bodies, {}, mesh);
   whole.clear();
   std::vector<unsigned int>().swap(bodies);
   malloc_trim(0);

@@ -12,7 +12,9 @@
 #include <metis.h>
 
 #include <algorithm>
+#include <array>
 #include <bitset>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -37,7 +39,9 @@ namespace knee_contact
 
     /**
      * Set @p whole's subdomain ids to a partition of its cells into
-     * @p n_parts parts of about equal size, with few faces between parts:
+     * @p n_parts parts of about equal size (the number of cells; given
+     * @p weights by active_cell_index(), both the cells' shares of the
+     * vertices and the weights' sum), with few faces between parts:
      * METIS on the cells' face graph, as deal.II's
      * GridTools::partition_triangulation() does (recursive bisection up to
      * 8 parts, k-way beyond, as its SparsityTools::partition() chooses),
@@ -48,7 +52,9 @@ namespace knee_contact
      */
     template <int dim>
     void
-    partition_cells(Triangulation<dim> &whole, const unsigned int n_parts)
+    partition_cells(Triangulation<dim>        &whole,
+                    const std::vector<double> &weights,
+                    const unsigned int         n_parts)
     {
       AssertThrow(whole.n_levels() == 1, ExcInternalError());
       const unsigned int n_cells = whole.n_active_cells();
@@ -71,26 +77,62 @@ namespace knee_contact
                   adjncy.push_back(cell->neighbor(f)->active_cell_index());
               xadj[cell->active_cell_index() + 1] = adjncy.size();
             }
+          // With weights, two constraints: the cells' shares of the
+          // vertices (the rows) and their weights, each scaled to a mean of
+          // 100 (METIS takes integers), their sums within idx_t.
+          std::vector<idx_t> vertex_weights;
+          idx_t              n_constraints = 1;
+          if (!weights.empty())
+            {
+              AssertThrow(weights.size() == n_cells, ExcInternalError());
+              std::vector<unsigned int> cells_at(whole.n_vertices(), 0);
+              for (const auto &cell : whole.active_cell_iterators())
+                for (const unsigned int v : cell->vertex_indices())
+                  ++cells_at[cell->vertex_index(v)];
+              std::vector<double> rows(n_cells, 0);
+              for (const auto &cell : whole.active_cell_iterators())
+                for (const unsigned int v : cell->vertex_indices())
+                  rows[cell->active_cell_index()] +=
+                    1. / cells_at[cell->vertex_index(v)];
+              const std::array<const std::vector<double> *, 2> columns = {
+                {&rows, &weights}};
+              std::array<double, 2> scale;
+              for (unsigned int k = 0; k < 2; ++k)
+                {
+                  double sum = 0;
+                  for (const double w : *columns[k])
+                    sum += w;
+                  AssertThrow(sum > 0 && std::isfinite(sum),
+                              ExcInternalError());
+                  scale[k] = std::min(100. * n_cells, 1e9) / sum;
+                }
+              for (unsigned int c = 0; c < n_cells; ++c)
+                for (unsigned int k = 0; k < 2; ++k)
+                  vertex_weights.push_back(
+                    std::max<idx_t>(1,
+                                    std::lround((*columns[k])[c] * scale[k])));
+              n_constraints = 2;
+            }
           idx_t options[METIS_NOPTIONS];
           METIS_SetDefaultOptions(options);
           options[METIS_OPTION_NUMBERING] = 0;
-          idx_t n_vertices = n_cells, n_constraints = 1, parts = n_parts,
-                cut = 0;
+          idx_t      n_vertices = n_cells, parts = n_parts, cut = 0;
           const auto method =
             n_parts <= 8 ? METIS_PartGraphRecursive : METIS_PartGraphKway;
-          const int status = method(&n_vertices,
-                                    &n_constraints,
-                                    xadj.data(),
-                                    adjncy.empty() ? nullptr : adjncy.data(),
-                                    nullptr,
-                                    nullptr,
-                                    nullptr,
-                                    &parts,
-                                    nullptr,
-                                    nullptr,
-                                    options,
-                                    &cut,
-                                    part.data());
+          const int status =
+            method(&n_vertices,
+                   &n_constraints,
+                   xadj.data(),
+                   adjncy.empty() ? nullptr : adjncy.data(),
+                   vertex_weights.empty() ? nullptr : vertex_weights.data(),
+                   nullptr,
+                   nullptr,
+                   &parts,
+                   nullptr,
+                   nullptr,
+                   options,
+                   &cut,
+                   part.data());
           if (status == METIS_ERROR_MEMORY)
             throw std::bad_alloc();
           AssertThrow(status == METIS_OK,
@@ -312,6 +354,7 @@ namespace knee_contact
   distribute_mesh(Triangulation<dim>              &whole,
                   const std::vector<unsigned int> &whole_body_of_cell,
                   const unsigned int               n_bodies,
+                  const std::vector<double>       &weights,
                   DistributedMesh<dim>            &mesh)
   {
     const MPI_Comm     comm  = mesh.triangulation.get_communicator();
@@ -324,7 +367,7 @@ namespace knee_contact
     Timer                     clock;
     if (first)
       {
-        partition_cells(whole, ranks);
+        partition_cells(whole, weights, ranks);
         // A body of the whole mesh by coarse cell: every cell of a coarse
         // cell's tree is of its body.
         body_of_coarse.assign(whole.n_cells(0), 0);
@@ -436,11 +479,13 @@ namespace knee_contact
   distribute_mesh(Triangulation<2> &,
                   const std::vector<unsigned int> &,
                   const unsigned int,
+                  const std::vector<double> &,
                   DistributedMesh<2> &);
   template void
   distribute_mesh(Triangulation<3> &,
                   const std::vector<unsigned int> &,
                   const unsigned int,
+                  const std::vector<double> &,
                   DistributedMesh<3> &);
   template void
   make_distributed_pattern(const DoFHandler<2> &,

@@ -169,7 +169,7 @@ namespace
     Triangulation<dim> given;
     given.copy_triangulation(whole);
     DistributedMesh<dim> mesh;
-    distribute_mesh(given, whole_body, n_bodies, mesh);
+    distribute_mesh(given, whole_body, n_bodies, {}, mesh);
     const bool released =
       Utilities::MPI::broadcast(comm, given.n_cells() == 0, 0);
     const auto        &tria  = mesh.triangulation;

@@ -133,7 +133,7 @@ namespace
           dofs_at[key(bodies[cell->active_cell_index()], cell->vertex(v))][d] =
             cell->vertex_dof_index(v, d);
     DistributedMesh<dim> mesh;
-    distribute_mesh(whole, bodies, n_bodies, mesh);
+    distribute_mesh(whole, bodies, n_bodies, {}, mesh);
     DoFHandler<dim> dofs(mesh.triangulation);
     dofs.distribute_dofs(whole_dofs.get_fe());
     const IndexSet                    owned = dofs.locally_owned_dofs();

@@ -278,6 +278,28 @@ namespace knee_contact
     std::vector<ContactInterface> list;
   };
 
+  /**
+   * The weight of each cell of a whole mesh of one level (by
+   * active_cell_index()) in the partition of a parallel run: its share of
+   * the entries its vertices' rows will have in the condensed system's
+   * pattern (ActiveSetSolver::make_sparsity_pattern(), counted by vertex),
+   * estimated before there are dofs or contact rows. A contact row widens
+   * the rows near its slave vertex by the master vertices it refers to and
+   * gives those masters its neighbourhood's columns: on the 3D knee at 2.3e5
+   * dofs the pattern of every set held 4.4e6 entries beyond the mesh's
+   * 1.04e7, three quarters of them on the rank of the master side, so that
+   * a partition of equal cells gave one of two ranks 8.4e6 entries and the
+   * other 6.3e6 (doc/parallel.md). Here each slave vertex refers to the
+   * master faces near its faces (mortar_rows()'s candidates) whose discs
+   * meet a slave face's along it: about the masters a row keeps. Written
+   * here because it needs the contact sides and no library knows them;
+   * distribute_mesh() balances these weights together with the rows.
+   */
+  template <int dim>
+  std::vector<double>
+  partition_weights(const Triangulation<dim> &whole,
+                    const ContactInterfaces  &interfaces);
+
 } // namespace knee_contact
 
 #endif

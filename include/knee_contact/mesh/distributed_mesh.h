@@ -139,7 +139,9 @@ namespace knee_contact
    * Divide rank 0's whole, checked mesh @p whole and its bodies
    * @p whole_body_of_cell (by active_cell_index(); @p n_bodies of them)
    * over the ranks of the run: rank 0 partitions the cells
-   * (METIS on the cells' face graph, which sets @p whole's
+   * (METIS on the cells' face graph, balancing the number of cells, or
+   * given @p weights by active_cell_index() both the vertices each rank
+   * holds and the sum of its cells' weights; this sets @p whole's
    * subdomain ids), makes each rank's description (its cells, their ghost
    * layer and the coarse cells they descend from, with material, boundary
    * and manifold ids) and sends it; every rank makes its part of the mesh
@@ -153,6 +155,7 @@ namespace knee_contact
   distribute_mesh(Triangulation<dim>              &whole,
                   const std::vector<unsigned int> &whole_body_of_cell,
                   const unsigned int               n_bodies,
+                  const std::vector<double>       &weights,
                   DistributedMesh<dim>            &mesh);
 
   /**

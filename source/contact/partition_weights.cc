@@ -1,0 +1,205 @@
+// The weights of a whole mesh's cells for the partition of a parallel run:
+// partition_weights().
+#include <knee_contact/contact/contact.h>
+#include <knee_contact/contact/search.h>
+
+#include <algorithm>
+#include <map>
+#include <vector>
+
+namespace knee_contact
+{
+  template <int dim>
+  std::vector<double>
+  partition_weights(const Triangulation<dim> &whole,
+                    const ContactInterfaces  &interfaces)
+  {
+    AssertThrow(whole.n_levels() == 1, ExcInternalError());
+    const unsigned int n_vertices = whole.n_vertices();
+    // The cells at each vertex (compressed rows).
+    std::vector<unsigned int> cells_start(n_vertices + 1, 0), cells_at;
+    for (const auto &cell : whole.active_cell_iterators())
+      for (const unsigned int v : cell->vertex_indices())
+        ++cells_start[cell->vertex_index(v) + 1];
+    for (unsigned int v = 0; v < n_vertices; ++v)
+      cells_start[v + 1] += cells_start[v];
+    cells_at.resize(cells_start.back());
+    {
+      std::vector<unsigned int> next(cells_start.begin(),
+                                     cells_start.end() - 1);
+      for (const auto &cell : whole.active_cell_iterators())
+        for (const unsigned int v : cell->vertex_indices())
+          cells_at[next[cell->vertex_index(v)]++] = cell->active_cell_index();
+    }
+    std::vector<typename Triangulation<dim>::active_cell_iterator> cell_of(
+      whole.n_active_cells());
+    for (const auto &cell : whole.active_cell_iterators())
+      cell_of[cell->active_cell_index()] = cell;
+    // A vertex's row of the mesh's pattern: the vertices of its cells.
+    const auto row = [&](const unsigned int v) {
+      std::vector<unsigned int> columns;
+      for (unsigned int k = cells_start[v]; k < cells_start[v + 1]; ++k)
+        for (const unsigned int w : cell_of[cells_at[k]]->vertex_indices())
+          columns.push_back(cell_of[cells_at[k]]->vertex_index(w));
+      std::sort(columns.begin(), columns.end());
+      columns.erase(std::unique(columns.begin(), columns.end()), columns.end());
+      return columns;
+    };
+
+    // The vertices each slave vertex's row refers to (E(s) of
+    // ActiveSetSolver's pattern, by vertex): itself and the vertices of the
+    // master faces near its faces, found as mortar_rows() finds its
+    // candidates (the faces meeting a slave face's box grown by the
+    // distance to the nearest, at most the maximum gap), so a superset of
+    // those a row keeps.
+    std::map<unsigned int, std::vector<unsigned int>> refers;
+    // A face's centre and its largest distance from it (its vertices lie in
+    // the disc of that radius).
+    const auto disc = [&](const std::vector<unsigned int> &face) {
+      Point<dim> centre;
+      for (const unsigned int v : face)
+        centre += whole.get_vertices()[v] / double(face.size());
+      double radius = 0;
+      for (const unsigned int v : face)
+        radius = std::max(radius, centre.distance(whole.get_vertices()[v]));
+      return std::make_pair(centre, radius);
+    };
+    for (const ContactInterface &interface : interfaces.interfaces())
+      {
+        std::vector<std::vector<unsigned int>> slave_faces, master_faces;
+        std::vector<BoundingBox<dim>>          master_boxes;
+        for (const auto &cell : whole.active_cell_iterators())
+          for (const unsigned int f : cell->face_indices())
+            if (cell->face(f)->at_boundary())
+              {
+                const types::boundary_id id = cell->face(f)->boundary_id();
+                if (id != interface.slave_id && id != interface.master_id)
+                  continue;
+                std::vector<unsigned int> face;
+                std::vector<Point<dim>>   points;
+                for (const unsigned int v : cell->face(f)->vertex_indices())
+                  {
+                    face.push_back(cell->face(f)->vertex_index(v));
+                    points.push_back(cell->face(f)->vertex(v));
+                  }
+                if (id == interface.slave_id)
+                  slave_faces.push_back(face);
+                else
+                  {
+                    master_faces.push_back(face);
+                    master_boxes.emplace_back(points);
+                  }
+              }
+        if (master_faces.empty())
+          continue;
+        const ContactSearch<dim> search(master_boxes);
+        for (const auto &face : slave_faces)
+          {
+            std::vector<Point<dim>> points;
+            for (const unsigned int v : face)
+              points.push_back(whole.get_vertices()[v]);
+            // The face's unit normal: the masters it faces are those whose
+            // discs meet its disc along the face (the clipping of
+            // mortar_rows() keeps the overlapping ones).
+            Tensor<1, dim> normal;
+            if constexpr (dim == 2)
+              normal = cross_product_2d(points[1] - points[0]);
+            else
+              normal =
+                cross_product_3d(points[1] - points[0], points[2] - points[0]);
+            normal /= std::max(normal.norm(), 1e-300);
+            const auto [centre, radius] = disc(face);
+            std::vector<unsigned int> masters;
+            for (const unsigned int m : search.near(
+                   BoundingBox<dim>(points), centre, 0., interface.maximum_gap))
+              {
+                const auto [master_centre, master_radius] =
+                  disc(master_faces[m]);
+                Tensor<1, dim> along = master_centre - centre;
+                along -= (along * normal) * normal;
+                if (along.norm() < radius + master_radius)
+                  masters.insert(masters.end(),
+                                 master_faces[m].begin(),
+                                 master_faces[m].end());
+              }
+            for (const unsigned int s : face)
+              {
+                auto &e = refers[s];
+                if (e.empty())
+                  e.push_back(s);
+                e.insert(e.end(), masters.begin(), masters.end());
+              }
+          }
+      }
+    for (auto &[s, e] : refers)
+      {
+        std::sort(e.begin(), e.end());
+        e.erase(std::unique(e.begin(), e.end()), e.end());
+      }
+
+    // Each vertex's entries: its mesh row's, or (a vertex whose row the
+    // contact rows widen: near a slave, or referred to by one) as
+    // ActiveSetSolver's pattern expands it: the row's columns each replaced
+    // by what it refers to, and a slave's row added to every vertex it
+    // refers to instead of its own.
+    std::vector<bool> widens(n_vertices, false);
+    for (const auto &[s, e] : refers)
+      {
+        for (unsigned int k = cells_start[s]; k < cells_start[s + 1]; ++k)
+          for (const unsigned int w : cell_of[cells_at[k]]->vertex_indices())
+            widens[cell_of[cells_at[k]]->vertex_index(w)] = true;
+        for (const unsigned int a : e)
+          widens[a] = true;
+      }
+    std::vector<double>                               entries(n_vertices, 0);
+    std::map<unsigned int, std::vector<unsigned int>> widened;
+    for (unsigned int v = 0; v < n_vertices; ++v)
+      {
+        std::vector<unsigned int> columns = row(v);
+        if (!widens[v])
+          {
+            entries[v] = columns.size();
+            continue;
+          }
+        std::vector<unsigned int> expanded;
+        for (const unsigned int j : columns)
+          if (const auto e = refers.find(j); e != refers.end())
+            expanded.insert(expanded.end(), e->second.begin(), e->second.end());
+          else
+            expanded.push_back(j);
+        if (const auto e = refers.find(v); e != refers.end())
+          for (const unsigned int a : e->second)
+            {
+              auto &w = widened[a];
+              w.insert(w.end(), expanded.begin(), expanded.end());
+            }
+        else
+          {
+            auto &w = widened[v];
+            w.insert(w.end(), expanded.begin(), expanded.end());
+          }
+      }
+    for (auto &[a, w] : widened)
+      {
+        std::sort(w.begin(), w.end());
+        entries[a] = std::unique(w.begin(), w.end()) - w.begin();
+      }
+
+    // A cell's share of its vertices' rows.
+    std::vector<double> weights(whole.n_active_cells(), 0);
+    for (const auto &cell : whole.active_cell_iterators())
+      for (const unsigned int v : cell->vertex_indices())
+        {
+          const unsigned int vertex = cell->vertex_index(v);
+          weights[cell->active_cell_index()] +=
+            entries[vertex] / (cells_start[vertex + 1] - cells_start[vertex]);
+        }
+    return weights;
+  }
+
+  template std::vector<double>
+  partition_weights(const Triangulation<2> &, const ContactInterfaces &);
+  template std::vector<double>
+  partition_weights(const Triangulation<3> &, const ContactInterfaces &);
+
+} // namespace knee_contact
