@@ -16,31 +16,41 @@ namespace knee_contact
   {
     AssertThrow(whole.n_levels() == 1, ExcInternalError());
     const unsigned int n_vertices = whole.n_vertices();
-    // The cells at each vertex (compressed rows).
-    std::vector<unsigned int> cells_start(n_vertices + 1, 0), cells_at;
+    // Each cell's vertices and the cells at each vertex (compressed rows;
+    // iterators over 2e6 cells took longer than the rest).
+    const unsigned int        n_cells = whole.n_active_cells();
+    std::vector<unsigned int> vertices_start(n_cells + 1, 0), vertices_of;
     for (const auto &cell : whole.active_cell_iterators())
-      for (const unsigned int v : cell->vertex_indices())
-        ++cells_start[cell->vertex_index(v) + 1];
+      {
+        for (const unsigned int v : cell->vertex_indices())
+          vertices_of.push_back(cell->vertex_index(v));
+        vertices_start[cell->active_cell_index() + 1] = vertices_of.size();
+      }
+    std::vector<unsigned int> cells_start(n_vertices + 1, 0), cells_at;
+    for (const unsigned int v : vertices_of)
+      ++cells_start[v + 1];
     for (unsigned int v = 0; v < n_vertices; ++v)
       cells_start[v + 1] += cells_start[v];
     cells_at.resize(cells_start.back());
     {
       std::vector<unsigned int> next(cells_start.begin(),
                                      cells_start.end() - 1);
-      for (const auto &cell : whole.active_cell_iterators())
-        for (const unsigned int v : cell->vertex_indices())
-          cells_at[next[cell->vertex_index(v)]++] = cell->active_cell_index();
+      for (unsigned int c = 0; c < n_cells; ++c)
+        for (unsigned int k = vertices_start[c]; k < vertices_start[c + 1]; ++k)
+          cells_at[next[vertices_of[k]]++] = c;
     }
-    std::vector<typename Triangulation<dim>::active_cell_iterator> cell_of(
-      whole.n_active_cells());
-    for (const auto &cell : whole.active_cell_iterators())
-      cell_of[cell->active_cell_index()] = cell;
+    // f(w) for each vertex w of the cells at v (repeated).
+    const auto for_each_near = [&](const unsigned int v, const auto &f) {
+      for (unsigned int k = cells_start[v]; k < cells_start[v + 1]; ++k)
+        for (unsigned int l = vertices_start[cells_at[k]];
+             l < vertices_start[cells_at[k] + 1];
+             ++l)
+          f(vertices_of[l]);
+    };
     // A vertex's row of the mesh's pattern: the vertices of its cells.
     const auto row = [&](const unsigned int v) {
       std::vector<unsigned int> columns;
-      for (unsigned int k = cells_start[v]; k < cells_start[v + 1]; ++k)
-        for (const unsigned int w : cell_of[cells_at[k]]->vertex_indices())
-          columns.push_back(cell_of[cells_at[k]]->vertex_index(w));
+      for_each_near(v, [&](const unsigned int w) { columns.push_back(w); });
       std::sort(columns.begin(), columns.end());
       columns.erase(std::unique(columns.begin(), columns.end()), columns.end());
       return columns;
@@ -48,10 +58,9 @@ namespace knee_contact
 
     // The vertices each slave vertex's row refers to (E(s) of
     // ActiveSetSolver's pattern, by vertex): itself and the vertices of the
-    // master faces near its faces, found as mortar_rows() finds its
-    // candidates (the faces meeting a slave face's box grown by the
-    // distance to the nearest, at most the maximum gap), so a superset of
-    // those a row keeps.
+    // master faces near its faces: mortar_rows()'s candidates (the faces
+    // meeting a slave face's box grown by the distance to the nearest, at
+    // most the maximum gap) whose discs meet the slave face's along it.
     std::map<unsigned int, std::vector<unsigned int>> refers;
     // A face's centre and its largest distance from it (its vertices lie in
     // the disc of that radius).
@@ -145,23 +154,31 @@ namespace knee_contact
     std::vector<bool> widens(n_vertices, false);
     for (const auto &[s, e] : refers)
       {
-        for (unsigned int k = cells_start[s]; k < cells_start[s + 1]; ++k)
-          for (const unsigned int w : cell_of[cells_at[k]]->vertex_indices())
-            widens[cell_of[cells_at[k]]->vertex_index(w)] = true;
+        for_each_near(s, [&](const unsigned int w) { widens[w] = true; });
         for (const unsigned int a : e)
           widens[a] = true;
       }
     std::vector<double>                               entries(n_vertices, 0);
     std::map<unsigned int, std::vector<unsigned int>> widened;
+    // The others' rows counted, not sorted: a vertex seen from v is marked
+    // with v.
+    std::vector<unsigned int> seen_from(n_vertices,
+                                        numbers::invalid_unsigned_int);
     for (unsigned int v = 0; v < n_vertices; ++v)
       {
-        std::vector<unsigned int> columns = row(v);
         if (!widens[v])
           {
-            entries[v] = columns.size();
+            for_each_near(v, [&](const unsigned int w) {
+              if (seen_from[w] != v)
+                {
+                  seen_from[w] = v;
+                  ++entries[v];
+                }
+            });
             continue;
           }
-        std::vector<unsigned int> expanded;
+        const std::vector<unsigned int> columns = row(v);
+        std::vector<unsigned int>       expanded;
         for (const unsigned int j : columns)
           if (const auto e = refers.find(j); e != refers.end())
             expanded.insert(expanded.end(), e->second.begin(), e->second.end());
@@ -186,13 +203,12 @@ namespace knee_contact
       }
 
     // A cell's share of its vertices' rows.
-    std::vector<double> weights(whole.n_active_cells(), 0);
-    for (const auto &cell : whole.active_cell_iterators())
-      for (const unsigned int v : cell->vertex_indices())
+    std::vector<double> weights(n_cells, 0);
+    for (unsigned int c = 0; c < n_cells; ++c)
+      for (unsigned int k = vertices_start[c]; k < vertices_start[c + 1]; ++k)
         {
-          const unsigned int vertex = cell->vertex_index(v);
-          weights[cell->active_cell_index()] +=
-            entries[vertex] / (cells_start[vertex + 1] - cells_start[vertex]);
+          const unsigned int v = vertices_of[k];
+          weights[c] += entries[v] / (cells_start[v + 1] - cells_start[v]);
         }
     return weights;
   }

@@ -474,14 +474,14 @@ namespace knee_contact
     distributed = std::make_unique<DistributedMesh<dim>>();
     // The partition balances the entries of the condensed system's rows,
     // which contact widens near its surfaces (partition_weights()).
-    Timer                     clock;
-    const std::vector<double> weights =
+    Timer               clock;
+    std::vector<double> weights =
       parallel::rank() == 0 && parallel::n_ranks() > 1
         ? partition_weights(triangulation, contact_interfaces)
         : std::vector<double>();
     const double weights_time = clock.wall_time();
     distribute_mesh(
-      triangulation, body_of_cell, n_bodies, weights, *distributed);
+      triangulation, body_of_cell, n_bodies, std::move(weights), *distributed);
     distributed->times["partition"] += weights_time;
     dof_handler.reinit(distributed->triangulation);
     triangulation.clear();

@@ -354,7 +354,7 @@ namespace knee_contact
   distribute_mesh(Triangulation<dim>              &whole,
                   const std::vector<unsigned int> &whole_body_of_cell,
                   const unsigned int               n_bodies,
-                  const std::vector<double>       &weights,
+                  std::vector<double>              weights,
                   DistributedMesh<dim>            &mesh)
   {
     const MPI_Comm     comm  = mesh.triangulation.get_communicator();
@@ -368,6 +368,7 @@ namespace knee_contact
     if (first)
       {
         partition_cells(whole, weights, ranks);
+        std::vector<double>().swap(weights);
         // A body of the whole mesh by coarse cell: every cell of a coarse
         // cell's tree is of its body.
         body_of_coarse.assign(whole.n_cells(0), 0);
@@ -479,13 +480,13 @@ namespace knee_contact
   distribute_mesh(Triangulation<2> &,
                   const std::vector<unsigned int> &,
                   const unsigned int,
-                  const std::vector<double> &,
+                  std::vector<double>,
                   DistributedMesh<2> &);
   template void
   distribute_mesh(Triangulation<3> &,
                   const std::vector<unsigned int> &,
                   const unsigned int,
-                  const std::vector<double> &,
+                  std::vector<double>,
                   DistributedMesh<3> &);
   template void
   make_distributed_pattern(const DoFHandler<2> &,

@@ -155,7 +155,7 @@ namespace knee_contact
   distribute_mesh(Triangulation<dim>              &whole,
                   const std::vector<unsigned int> &whole_body_of_cell,
                   const unsigned int               n_bodies,
-                  const std::vector<double>       &weights,
+                  std::vector<double>              weights,
                   DistributedMesh<dim>            &mesh);
 
   /**
