@@ -160,6 +160,22 @@ namespace knee_contact
       }
     std::vector<double>                               entries(n_vertices, 0);
     std::map<unsigned int, std::vector<unsigned int>> widened;
+    // A master vertex gathers the rows of every slave that refers to it,
+    // mostly the same columns: sorted and made unique whenever it doubled,
+    // so that it holds at most about twice its row.
+    std::map<unsigned int, std::size_t> compacted;
+    const auto                          add = [&](const unsigned int               a,
+                         const std::vector<unsigned int> &columns) {
+      auto &w = widened[a];
+      w.insert(w.end(), columns.begin(), columns.end());
+      auto &size = compacted[a];
+      if (w.size() > 2 * size + 256)
+        {
+          std::sort(w.begin(), w.end());
+          w.erase(std::unique(w.begin(), w.end()), w.end());
+          size = w.size();
+        }
+    };
     // The others' rows counted, not sorted: a vertex seen from v is marked
     // with v.
     std::vector<unsigned int> seen_from(n_vertices,
@@ -186,15 +202,9 @@ namespace knee_contact
             expanded.push_back(j);
         if (const auto e = refers.find(v); e != refers.end())
           for (const unsigned int a : e->second)
-            {
-              auto &w = widened[a];
-              w.insert(w.end(), expanded.begin(), expanded.end());
-            }
+            add(a, expanded);
         else
-          {
-            auto &w = widened[v];
-            w.insert(w.end(), expanded.begin(), expanded.end());
-          }
+          add(v, expanded);
       }
     for (auto &[a, w] : widened)
       {
