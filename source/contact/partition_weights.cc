@@ -73,40 +73,47 @@ namespace knee_contact
         radius = std::max(radius, centre.distance(whole.get_vertices()[v]));
       return std::make_pair(centre, radius);
     };
+    // The faces of every contact side, by boundary id, in one pass.
+    std::map<types::boundary_id, std::vector<std::vector<unsigned int>>>
+      side_faces;
     for (const ContactInterface &interface : interfaces.interfaces())
       {
-        std::vector<std::vector<unsigned int>> slave_faces, master_faces;
-        std::vector<BoundingBox<dim>>          master_boxes;
-        for (const auto &cell : whole.active_cell_iterators())
-          for (const unsigned int f : cell->face_indices())
-            if (cell->face(f)->at_boundary())
-              {
-                const types::boundary_id id = cell->face(f)->boundary_id();
-                if (id != interface.slave_id && id != interface.master_id)
-                  continue;
-                std::vector<unsigned int> face;
-                std::vector<Point<dim>>   points;
-                for (const unsigned int v : cell->face(f)->vertex_indices())
-                  {
-                    face.push_back(cell->face(f)->vertex_index(v));
-                    points.push_back(cell->face(f)->vertex(v));
-                  }
-                if (id == interface.slave_id)
-                  slave_faces.push_back(face);
-                else
-                  {
-                    master_faces.push_back(face);
-                    master_boxes.emplace_back(points);
-                  }
-              }
+        side_faces[interface.slave_id];
+        side_faces[interface.master_id];
+      }
+    for (const auto &cell : whole.active_cell_iterators())
+      for (const unsigned int f : cell->face_indices())
+        if (cell->face(f)->at_boundary())
+          if (const auto side = side_faces.find(cell->face(f)->boundary_id());
+              side != side_faces.end())
+            {
+              std::vector<unsigned int> face;
+              for (const unsigned int v : cell->face(f)->vertex_indices())
+                face.push_back(cell->face(f)->vertex_index(v));
+              side->second.push_back(std::move(face));
+            }
+    const auto points_of = [&](const std::vector<unsigned int> &face) {
+      std::vector<Point<dim>> points;
+      for (const unsigned int v : face)
+        points.push_back(whole.get_vertices()[v]);
+      return points;
+    };
+    for (const ContactInterface &interface : interfaces.interfaces())
+      {
+        const auto &master_faces = side_faces[interface.master_id];
         if (master_faces.empty())
           continue;
-        const ContactSearch<dim> search(master_boxes);
-        for (const auto &face : slave_faces)
+        std::vector<BoundingBox<dim>>              master_boxes;
+        std::vector<std::pair<Point<dim>, double>> master_discs;
+        for (const auto &face : master_faces)
           {
-            std::vector<Point<dim>> points;
-            for (const unsigned int v : face)
-              points.push_back(whole.get_vertices()[v]);
+            master_boxes.emplace_back(points_of(face));
+            master_discs.push_back(disc(face));
+          }
+        const ContactSearch<dim> search(master_boxes);
+        for (const auto &face : side_faces[interface.slave_id])
+          {
+            const std::vector<Point<dim>> points = points_of(face);
             // The face's unit normal: the masters it faces are those whose
             // discs meet its disc along the face (the clipping of
             // mortar_rows() keeps the overlapping ones).
@@ -122,8 +129,7 @@ namespace knee_contact
             for (const unsigned int m : search.near(
                    BoundingBox<dim>(points), centre, 0., interface.maximum_gap))
               {
-                const auto [master_centre, master_radius] =
-                  disc(master_faces[m]);
+                const auto &[master_centre, master_radius] = master_discs[m];
                 Tensor<1, dim> along = master_centre - centre;
                 along -= (along * normal) * normal;
                 if (along.norm() < radius + master_radius)

@@ -71,6 +71,8 @@
 
 #include <deal.II/dofs/dof_tools.h>
 
+#include "run_quietly.h"
+
 #include <array>
 #include <cmath>
 #include <cstdlib>
@@ -104,14 +106,7 @@ namespace
   {
     const MPI_Comm      comm = knee_contact::parallel::communicator();
     ContactProblem<dim> problem(SOURCE_DIR "/" + scene);
-    {
-      // The run's own report is checked by its scene test, not here.
-      std::ostringstream report;
-      std::streambuf    *out  = std::cout.rdbuf(report.rdbuf());
-      const int          code = problem.run();
-      std::cout.rdbuf(out);
-      AssertThrow(code == 0, ExcMessage(scene + " failed"));
-    }
+    run_quietly(problem, scene);
     const DoFHandler<dim> &whole_dofs = problem.dof_handler_of();
     const Vector<double>  &x          = problem.solution();
     Vector<double>         Cx(x.size());
