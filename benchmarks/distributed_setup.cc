@@ -117,8 +117,7 @@ main(int argc, char **argv)
     },
     lines,
     pairs.rows,
-    modes.rigid_motions(),
-    3,
+    modes,
     problem.contact_solver().krylov_settings());
   say("C's rows assembled");
   system.set_rhs(d);

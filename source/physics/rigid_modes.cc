@@ -8,8 +8,10 @@
 #include <deal.II/lac/lapack_full_matrix.h>
 
 #include <deal.II/distributed/tria_base.h>
+#include <deal.II/dofs/dof_tools.h>
 #include <deal.II/fe/fe.h>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -19,13 +21,31 @@ namespace knee_contact
   RigidModes<dim>::RigidModes(const DoFHandler<dim>           &dof_handler,
                               const std::vector<unsigned int> &body_of_cell,
                               const std::vector<std::string>  &body_names)
-    : dof_body(dof_handler.n_dofs())
-    , dof_component(dof_handler.n_dofs())
-    , dof_position(dof_handler.n_dofs())
-    , centre(body_names.size())
+    : centre(body_names.size())
     , size(body_names.size())
     , names(body_names)
   {
+    // A distributed mesh: this rank knows the dofs of its cells and their
+    // ghosts, and evaluates the rows on those it owns (free_motion()).
+    const auto *mesh =
+      dynamic_cast<const dealii::parallel::TriangulationBase<dim> *>(
+        &dof_handler.get_triangulation());
+    distributed = mesh != nullptr;
+    if (distributed)
+      {
+        communicator = mesh->get_communicator();
+        owned        = dof_handler.locally_owned_dofs();
+        DoFTools::extract_locally_relevant_dofs(dof_handler, known);
+      }
+    else
+      {
+        owned = complete_index_set(dof_handler.n_dofs());
+        known = owned;
+      }
+    dof_body.resize(known.n_elements());
+    dof_component.resize(known.n_elements());
+    dof_position.resize(known.n_elements());
+
     // Each dof's position. The elements are linear (elements.cc): every
     // dof sits at a vertex, whose position any mapping keeps, so it is read
     // from the cells' vertices; DoFTools::map_dofs_to_support_points()
@@ -50,12 +70,11 @@ namespace knee_contact
               const Point<dim> &x = cell->vertex(v);
               for (unsigned int c = 0; c < fe.n_dofs_per_vertex(); ++c)
                 {
-                  const types::global_dof_index dof =
-                    cell->vertex_dof_index(v, c);
-                  dof_position[dof] = x;
-                  dof_body[dof]     = body;
+                  const std::size_t i = at(cell->vertex_dof_index(v, c));
+                  dof_position[i]     = x;
+                  dof_body[i]         = body;
                   // FESystem numbers a vertex's dofs by component.
-                  dof_component[dof] = c;
+                  dof_component[i] = c;
                 }
               for (unsigned int d = 0; d < dim; ++d)
                 {
@@ -64,42 +83,14 @@ namespace knee_contact
                 }
             }
         }
-    // A distributed mesh: every rank takes every dof's data from its
-    // owner (whole vectors, as the loop's: the rows' dofs are anywhere),
-    // packed as doubles for one all-gather (indices below 2^53), and the
-    // bodies' boxes over the ranks.
-    const auto *distributed =
-      dynamic_cast<const dealii::parallel::TriangulationBase<dim> *>(
-        &dof_handler.get_triangulation());
-    if (distributed != nullptr)
-      {
-        const MPI_Comm      comm = distributed->get_communicator();
-        std::vector<double> mine;
-        for (const auto dof : dof_handler.locally_owned_dofs())
+    // The bodies' boxes over the ranks.
+    if (distributed)
+      for (unsigned int b = 0; b < names.size(); ++b)
+        for (unsigned int d = 0; d < dim; ++d)
           {
-            mine.push_back(dof);
-            mine.push_back(dof_body[dof]);
-            mine.push_back(dof_component[dof]);
-            for (unsigned int d = 0; d < dim; ++d)
-              mine.push_back(dof_position[dof][d]);
+            lower[b][d] = Utilities::MPI::min(lower[b][d], communicator);
+            upper[b][d] = Utilities::MPI::max(upper[b][d], communicator);
           }
-        const std::vector<double> all =
-          parallel::gather_on_every_rank(comm, mine);
-        for (std::size_t k = 0; k < all.size(); k += 3 + dim)
-          {
-            const auto dof     = types::global_dof_index(all[k]);
-            dof_body[dof]      = all[k + 1];
-            dof_component[dof] = all[k + 2];
-            for (unsigned int d = 0; d < dim; ++d)
-              dof_position[dof][d] = all[k + 3 + d];
-          }
-        for (unsigned int b = 0; b < names.size(); ++b)
-          for (unsigned int d = 0; d < dim; ++d)
-            {
-              lower[b][d] = Utilities::MPI::min(lower[b][d], comm);
-              upper[b][d] = Utilities::MPI::max(upper[b][d], comm);
-            }
-      }
     for (unsigned int b = 0; b < names.size(); ++b)
       {
         centre[b] = 0.5 * (lower[b] + upper[b]);
@@ -110,31 +101,66 @@ namespace knee_contact
 
 
   template <int dim>
-  std::vector<Vector<double>>
-  RigidModes<dim>::rigid_motions() const
+  std::size_t
+  RigidModes<dim>::at(const types::global_dof_index dof) const
   {
-    // Each body moves by its own mode about its own centre, scaled by its
-    // size, so that the vectors are of one magnitude on every body; as the
-    // bodies share no dof, each is a rigid motion of every body at once.
-    std::vector<Vector<double>> modes(n_modes,
-                                      Vector<double>(dof_position.size()));
-    for (types::global_dof_index i = 0; i < dof_position.size(); ++i)
+    AssertThrow(known.is_element(dof),
+                ExcMessage("RigidModes: dof " + std::to_string(dof) +
+                           " is not one this rank knows"));
+    return known.index_within_set(dof);
+  }
+
+
+
+  template <int dim>
+  unsigned int
+  RigidModes<dim>::add_modes(const types::global_dof_index dof,
+                             const double                  v,
+                             Vector<double>               &w) const
+  {
+    // The translations along the axes, then the rotations about the axes
+    // through the body's centre (2D: about z only), e_k x (x - centre),
+    // scaled by its size, so that the modes are of one magnitude on every
+    // body; as the bodies share no dof, each is a rigid motion of every
+    // body at once.
+    const std::size_t    i = at(dof);
+    const unsigned int   b = dof_body[i];
+    const unsigned int   c = dof_component[i];
+    const Tensor<1, dim> r = (dof_position[i] - centre[b]) / size[b];
+    w(n_modes * b + c) += v;
+    if constexpr (dim == 2)
+      w(n_modes * b + 2) += v * (c == 0 ? -r[1] : r[0]);
+    else
+      // (e_k x r)_c = epsilon_kjc r_j: nonzero for j, k, c distinct.
+      for (unsigned int k = 0; k < 3; ++k)
+        if (k != c)
+          {
+            const unsigned int j    = 3 - k - c;
+            const double       sign = (k + 1) % 3 == j ? 1. : -1.;
+            w(n_modes * b + 3 + k) += v * sign * r[j];
+          }
+    return b;
+  }
+
+
+
+  template <int dim>
+  std::vector<double>
+  RigidModes<dim>::rigid_motions(const IndexSet &rows) const
+  {
+    const std::size_t   n = rows.n_elements();
+    std::vector<double> modes(n_modes * n);
+    Vector<double>      w(n_modes * names.size());
+    std::size_t         local = 0;
+    for (const auto dof : rows)
       {
-        const unsigned int   b = dof_body[i];
-        const unsigned int   c = dof_component[i];
-        const Tensor<1, dim> r = (dof_position[i] - centre[b]) / size[b];
-        modes[c](i)            = 1;
-        if constexpr (dim == 2)
-          modes[2](i) = c == 0 ? -r[1] : r[0];
-        else
-          for (unsigned int k = 0; k < 3; ++k)
-            if (k != c)
-              {
-                // (e_k x r)_c = epsilon_kjc r_j.
-                const unsigned int j    = 3 - k - c;
-                const double       sign = (k + 1) % 3 == j ? 1. : -1.;
-                modes[3 + k](i)         = sign * r[j];
-              }
+        const unsigned int b = add_modes(dof, 1., w);
+        for (unsigned int k = 0; k < n_modes; ++k)
+          {
+            modes[k * n + local] = w(n_modes * b + k);
+            w(n_modes * b + k)   = 0;
+          }
+        ++local;
       }
     return modes;
   }
@@ -159,54 +185,116 @@ namespace knee_contact
                                const std::vector<ContactRow>   &pairs,
                                const std::vector<bool>         &active) const
   {
-    const unsigned int n_all = n_modes * names.size();
+    const unsigned int n_bodies = names.size(), n_all = n_modes * n_bodies;
     FullMatrix<double> gram(n_all, n_all);
     Vector<double>     w(n_all);
 
-    // Add one homogeneous constraint row sum_d v_d x_d = 0 to the Gram
-    // matrix, evaluated on the modes of body b: the translations along the
-    // axes, then the rotations about the axes through the body's centre
-    // (2D: about z only), e_k x (x - centre), scaled by its size.
-    const auto add_row =
-      [&](const std::vector<std::pair<types::global_dof_index, double>> &row) {
-        w           = 0;
-        double norm = 0;
-        for (const auto &[dof, v] : row)
-          {
-            const unsigned int   b = dof_body[dof];
-            const unsigned int   c = dof_component[dof];
-            const Tensor<1, dim> r = dof_position[dof] - centre[b];
-            w(n_modes * b + c) += v;
-            if constexpr (dim == 2)
-              w(n_modes * b + 2) += v * (c == 0 ? -r[1] : r[0]) / size[b];
-            else
-              // (e_k x r)_c = epsilon_kjc r_j: nonzero for j, k, c distinct.
-              for (unsigned int k = 0; k < 3; ++k)
-                if (k != c)
-                  {
-                    const unsigned int j    = 3 - k - c;
-                    const double       sign = (k + 1) % 3 == j ? 1. : -1.;
-                    w(n_modes * b + 3 + k) += v * sign * r[j] / size[b];
-                  }
-            norm += v * v;
-          }
-        if (norm > 0)
-          for (unsigned int i = 0; i < n_all; ++i)
-            for (unsigned int j = 0; j < n_all; ++j)
-              gram(i, j) += w(i) * w(j) / norm;
-      };
-
-    std::vector<std::pair<types::global_dof_index, double>> row;
+    // Each homogeneous constraint row sum_d v_d x_d = 0 adds w w^T / |v|^2
+    // to the Gram matrix, w the row evaluated on the modes. A line of
+    // base on the rank that owns its dof (its entries, a vertex's
+    // components or a hanging node's parents, lie on the cells around it,
+    // which the rank knows); it holds one body's dofs (the bodies share
+    // none), so it adds to that body's block only, and the ranks' blocks
+    // are summed.
+    std::vector<double> blocks(n_bodies * n_modes * n_modes, 0.);
     for (const auto &line : base.get_lines())
-      {
-        row.assign(1, {line.index, 1.});
-        for (const auto &[j, c] : line.entries)
-          row.emplace_back(j, -c);
-        add_row(row);
-      }
+      if (owned.is_element(line.index))
+        {
+          const unsigned int b    = add_modes(line.index, 1., w);
+          double             norm = 1;
+          for (const auto &[j, c] : line.entries)
+            {
+              AssertThrow(add_modes(j, -c, w) == b,
+                          ExcMessage("RigidModes: a constraint of dof " +
+                                     std::to_string(line.index) +
+                                     " couples two bodies"));
+              norm += c * c;
+            }
+          for (unsigned int i = 0; i < n_modes; ++i)
+            for (unsigned int j = 0; j < n_modes; ++j)
+              blocks[(b * n_modes + i) * n_modes + j] +=
+                w(n_modes * b + i) * w(n_modes * b + j) / norm;
+          for (unsigned int k = 0; k < n_modes; ++k)
+            w(n_modes * b + k) = 0;
+        }
+
+    // An active contact row: each rank evaluates it on the dofs it owns
+    // (its master dofs are anywhere), by body, and every rank sums the
+    // parts in the same order, so that every rank decides alike.
+    struct Part
+    {
+      unsigned int row, body;
+      double       w[n_modes];
+    };
+    std::vector<Part> parts;
+    std::vector<bool> touched(n_bodies, false);
     for (unsigned int p = 0; p < pairs.size(); ++p)
       if (active[p])
-        add_row(pairs[p].row);
+        {
+          for (const auto &[dof, v] : pairs[p].row)
+            if (owned.is_element(dof))
+              touched[add_modes(dof, v, w)] = true;
+          for (unsigned int b = 0; b < n_bodies; ++b)
+            if (touched[b])
+              {
+                Part part{p, b, {}};
+                for (unsigned int k = 0; k < n_modes; ++k)
+                  {
+                    part.w[k]          = w(n_modes * b + k);
+                    w(n_modes * b + k) = 0;
+                  }
+                parts.push_back(part);
+                touched[b] = false;
+              }
+        }
+    if (distributed && !blocks.empty())
+      {
+        const std::vector<double> all =
+          parallel::gather_on_every_rank(communicator, blocks);
+        std::fill(blocks.begin(), blocks.end(), 0.);
+        for (std::size_t k = 0; k < all.size(); ++k)
+          blocks[k % blocks.size()] += all[k]; // (rank by rank)
+        parts = parallel::gather_on_every_rank(communicator, parts);
+        std::stable_sort(parts.begin(),
+                         parts.end(),
+                         [](const Part &a, const Part &b) {
+                           return a.row < b.row;
+                         });
+      }
+    for (unsigned int b = 0; b < n_bodies; ++b)
+      for (unsigned int i = 0; i < n_modes; ++i)
+        for (unsigned int j = 0; j < n_modes; ++j)
+          gram(n_modes * b + i, n_modes * b + j) =
+            blocks[(b * n_modes + i) * n_modes + j];
+    std::vector<unsigned int> bodies;
+    for (std::size_t first = 0; first < parts.size();)
+      {
+        const unsigned int p    = parts[first].row;
+        std::size_t        last = first;
+        bodies.clear();
+        for (; last < parts.size() && parts[last].row == p; ++last)
+          {
+            const unsigned int b = parts[last].body;
+            if (std::find(bodies.begin(), bodies.end(), b) == bodies.end())
+              bodies.push_back(b);
+            for (unsigned int k = 0; k < n_modes; ++k)
+              w(n_modes * b + k) += parts[last].w[k];
+          }
+        double norm = 0;
+        for (const auto &[dof, v] : pairs[p].row)
+          norm += v * v;
+        if (norm > 0)
+          for (const unsigned int a : bodies)
+            for (const unsigned int c : bodies)
+              for (unsigned int i = 0; i < n_modes; ++i)
+                for (unsigned int j = 0; j < n_modes; ++j)
+                  gram(n_modes * a + i, n_modes * c + j) +=
+                    w(n_modes * a + i) * w(n_modes * c + j) / norm;
+        for (const unsigned int a : bodies)
+          for (unsigned int k = 0; k < n_modes; ++k)
+            w(n_modes * a + k) = 0;
+        first = last;
+      }
 
     LAPACKFullMatrix<double> matrix(n_all);
     matrix         = gram;

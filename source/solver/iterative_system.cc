@@ -343,8 +343,7 @@ namespace knee_contact
                    const RowAssembly                       *assemble_rows,
                    const AffineConstraints<double>         &base,
                    const std::vector<ContactRow>           &pairs,
-                   const std::vector<Vector<double>>       &modes,
-                   const unsigned int                       components,
+                   const RigidModeCheck                    &rigid_modes,
                    const KrylovSettings                    &settings)
       : matrix(matrix)
       , pattern(pattern)
@@ -353,7 +352,7 @@ namespace knee_contact
                              : distributed_pattern->n_rows())
       , base(base)
       , pairs(pairs)
-      , components(components)
+      , components(rigid_modes.components())
       , settings(settings)
       , x(n)
     {
@@ -406,15 +405,8 @@ namespace knee_contact
       // ML reads the near null space as one column-major array of this
       // rank's rows (kept for each new hierarchy; whole it took 48 MB a
       // rank at 1e6 dofs).
-      const types::global_dof_index n_local = owned.n_elements();
-      null_space.resize(modes.size() * n_local);
-      for (unsigned int k = 0; k < modes.size(); ++k)
-        {
-          types::global_dof_index local = 0;
-          for (const auto i : owned)
-            null_space[k * n_local + local++] = modes[k](i);
-        }
-      n_modes = modes.size();
+      null_space = rigid_modes.rigid_motions(owned);
+      n_modes    = rigid_modes.n_rigid_motions();
       if (matrix == nullptr)
         assemble_rows_of_c(*assemble_rows);
     }
@@ -474,9 +466,16 @@ namespace knee_contact
     };
     std::vector<DofValue> line_diagonal;
     /** Several ranks: this rank's rows with a column a line can hold, and
-     * that column (condense() finds the rows a set changes from them). */
-    std::vector<std::pair<types::global_dof_index, types::global_dof_index>>
-                                      line_columns;
+     * those columns (condense() finds the rows a set changes from them),
+     * row by row: the columns of rows[r] are columns[start[r]] up to
+     * columns[start[r + 1]] (pairs of row and column took twice the
+     * memory: 39 MB of a rank's peak at 1e6 DoFs on four ranks). */
+    struct LineColumns
+    {
+      std::vector<types::global_dof_index> rows;
+      std::vector<std::size_t>             start;
+      std::vector<types::global_dof_index> columns;
+    } line_columns;
     TrilinosWrappers::PreconditionAMG amg;
     bool                              has_amg = false;
     /** The set the hierarchy was built for, and the dofs its tied
@@ -715,8 +714,11 @@ namespace knee_contact
                           });
         };
         if (indexed)
-          for (const auto &[row, j] : line_columns)
-            of_set[row] = of_set[row] || set_line[j];
+          for (std::size_t r = 0; r < line_columns.rows.size(); ++r)
+            for (std::size_t k = line_columns.start[r];
+                 k < line_columns.start[r + 1] && !of_set[line_columns.rows[r]];
+                 ++k)
+              of_set[line_columns.rows[r]] = set_line[line_columns.columns[k]];
         else
           for (const auto row : owned)
             mark(row);
@@ -927,7 +929,8 @@ namespace knee_contact
     // Their diagonal from their owners to every rank; this rank's rows
     // with such a column.
     std::vector<DofValue> mine;
-    line_columns.clear();
+    line_columns = {};
+    line_columns.start.push_back(0);
     for (const auto row : owned)
       {
         if (of_line[row])
@@ -935,10 +938,17 @@ namespace knee_contact
         for_each_in_row(row,
                         [&](const types::global_dof_index j, const double) {
                           if (of_line[j])
-                            line_columns.emplace_back(row, j);
+                            line_columns.columns.push_back(j);
                         });
+        if (line_columns.columns.size() > line_columns.start.back())
+          {
+            line_columns.rows.push_back(row);
+            line_columns.start.push_back(line_columns.columns.size());
+          }
       }
-    line_columns.shrink_to_fit();
+    line_columns.rows.shrink_to_fit();
+    line_columns.start.shrink_to_fit();
+    line_columns.columns.shrink_to_fit();
     line_diagonal =
       parallel::gather_on_every_rank(parallel::communicator(), mine);
     // (Rank order: each rank's rows are increasing, but on a METIS
@@ -1177,41 +1187,37 @@ namespace knee_contact
 
 
   IterativeContactSystem::IterativeContactSystem(
-    const SparseMatrix<double>        &matrix,
-    const AffineConstraints<double>   &base,
-    const std::vector<ContactRow>     &pairs,
-    const std::vector<Vector<double>> &modes,
-    const unsigned int                 components,
-    const KrylovSettings              &settings)
+    const SparseMatrix<double>      &matrix,
+    const AffineConstraints<double> &base,
+    const std::vector<ContactRow>   &pairs,
+    const RigidModeCheck            &rigid_modes,
+    const KrylovSettings            &settings)
     : IterativeContactSystem(&matrix.get_sparsity_pattern(),
                              nullptr,
                              &matrix,
                              nullptr,
                              base,
                              pairs,
-                             modes,
-                             components,
+                             rigid_modes,
                              settings)
   {}
 
 
 
   IterativeContactSystem::IterativeContactSystem(
-    const SparsityPattern             &pattern,
-    const RowAssembly                 &assemble_rows,
-    const AffineConstraints<double>   &base,
-    const std::vector<ContactRow>     &pairs,
-    const std::vector<Vector<double>> &modes,
-    const unsigned int                 components,
-    const KrylovSettings              &settings)
+    const SparsityPattern           &pattern,
+    const RowAssembly               &assemble_rows,
+    const AffineConstraints<double> &base,
+    const std::vector<ContactRow>   &pairs,
+    const RigidModeCheck            &rigid_modes,
+    const KrylovSettings            &settings)
     : IterativeContactSystem(&pattern,
                              nullptr,
                              nullptr,
                              &assemble_rows,
                              base,
                              pairs,
-                             modes,
-                             components,
+                             rigid_modes,
                              settings)
   {}
 
@@ -1222,8 +1228,7 @@ namespace knee_contact
     const RowAssembly                       &assemble_cells,
     const AffineConstraints<double>         &base,
     const std::vector<ContactRow>           &pairs,
-    const std::vector<Vector<double>>       &modes,
-    const unsigned int                       components,
+    const RigidModeCheck                    &rigid_modes,
     const KrylovSettings                    &settings)
     : IterativeContactSystem(nullptr,
                              &pattern,
@@ -1231,8 +1236,7 @@ namespace knee_contact
                              &assemble_cells,
                              base,
                              pairs,
-                             modes,
-                             components,
+                             rigid_modes,
                              settings)
   {}
 
@@ -1245,8 +1249,7 @@ namespace knee_contact
     const RowAssembly                       *assemble_rows,
     const AffineConstraints<double>         &base,
     const std::vector<ContactRow>           &pairs,
-    const std::vector<Vector<double>>       &modes,
-    const unsigned int                       components,
+    const RigidModeCheck                    &rigid_modes,
     const KrylovSettings                    &settings)
   {
     parallel::ensure_initialised();
@@ -1258,8 +1261,7 @@ namespace knee_contact
                                                       assemble_rows,
                                                       base,
                                                       pairs,
-                                                      modes,
-                                                      components,
+                                                      rigid_modes,
                                                       settings);
     implementation->resident_at_start = resident;
   }
@@ -1669,7 +1671,10 @@ namespace knee_contact
       replicated +=
         sizeof(row) +
         (row.row.capacity() + row.reduced_row.capacity()) * sizeof(row.row[0]);
-    double held = d.line_columns.capacity() * sizeof(d.line_columns[0]);
+    double held =
+      (d.line_columns.rows.capacity() + d.line_columns.columns.capacity()) *
+        sizeof(types::global_dof_index) +
+      d.line_columns.start.capacity() * sizeof(std::size_t);
     for (const auto &[row, entries] : d.held_rows)
       held += sizeof(row) + entries.capacity() * sizeof(entries[0]);
     return {{"amg_setups", d.totals.n_setups},

@@ -451,21 +451,10 @@ namespace knee_contact
         log << std::endl;
         if (rows != nullptr)
           choice.system = std::make_unique<IterativeContactSystem>(
-            sparsity,
-            *rows,
-            base,
-            pairs,
-            rigid_modes.rigid_motions(),
-            rigid_modes.components(),
-            krylov);
+            sparsity, *rows, base, pairs, rigid_modes, krylov);
         else
           choice.system = std::make_unique<IterativeContactSystem>(
-            matrix,
-            base,
-            pairs,
-            rigid_modes.rigid_motions(),
-            rigid_modes.components(),
-            krylov);
+            matrix, base, pairs, rigid_modes, krylov);
         return choice;
       }
     if (plan.path == SolverPath::condensed)
@@ -551,14 +540,8 @@ namespace knee_contact
     choice.name    = solver_path_name(plan.path);
     log << "   solver: iterative (" << plan.reason << "), on the mesh "
         << "distributed over " << parallel::n_ranks() << " ranks" << std::endl;
-    choice.system =
-      std::make_unique<IterativeContactSystem>(pattern,
-                                               rows,
-                                               base,
-                                               pairs,
-                                               rigid_modes.rigid_motions(),
-                                               rigid_modes.components(),
-                                               krylov);
+    choice.system = std::make_unique<IterativeContactSystem>(
+      pattern, rows, base, pairs, rigid_modes, krylov);
     return choice;
   }
 } // namespace knee_contact

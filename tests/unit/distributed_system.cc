@@ -275,8 +275,7 @@ namespace
       },
       lines,
       pairs.rows,
-      modes.rigid_motions(),
-      dim,
+      modes,
       krylov);
     system.set_rhs(d);
     std::ostringstream    loop_log;

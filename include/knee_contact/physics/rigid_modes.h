@@ -3,6 +3,9 @@
 
 #include <knee_contact/contact/contact_row.h>
 
+#include <deal.II/base/index_set.h>
+#include <deal.II/base/mpi.h>
+
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/vector.h>
 
@@ -28,6 +31,8 @@ namespace knee_contact
     /**
      * The description of the first free motion under @p base and the
      * active rows of @p rows, or an empty string if every body is held.
+     * On a distributed mesh collective (each rank evaluates the rows on
+     * the dofs it owns), with the same answer on every rank.
      */
     virtual std::string
     free_motion(const AffineConstraints<double> &base,
@@ -35,23 +40,30 @@ namespace knee_contact
                 const std::vector<bool>         &active) const = 0;
 
     /**
-     * Throw an ExcMessage naming the body and the free motion if the
-     * constraints leave one. @p context ends the message (what the user can
-     * do).
+     * The rigid motions of the mesh at the dofs of @p rows (dofs this
+     * rank knows: on a distributed mesh its locally relevant ones), one
+     * after the other: motion k at the i-th dof of @p rows is entry
+     * k * rows.n_elements() + i (ML's near null space). The translations
+     * along the axes, then the rotations about the axes through each
+     * body's centre scaled by its size (three in 2D, six in 3D); every
+     * body's stiffness matrix maps them to zero.
      */
-    /**
-     * The rigid motions of the whole mesh as dof vectors: the translations
-     * along the axes, then the rotations about the axes through the mesh's
-     * centre scaled by its size (three in 2D, six in 3D); every body's
-     * stiffness matrix maps them to zero. The near null space of AMG.
-     */
-    virtual std::vector<Vector<double>>
-    rigid_motions() const = 0;
+    virtual std::vector<double>
+    rigid_motions(const IndexSet &rows) const = 0;
+
+    /** The number of rigid motions rigid_motions() gives. */
+    virtual unsigned int
+    n_rigid_motions() const = 0;
 
     /** Dofs per vertex (the dimension). */
     virtual unsigned int
     components() const = 0;
 
+    /**
+     * Throw an ExcMessage naming the body and the free motion if the
+     * constraints leave one. @p context ends the message (what the user can
+     * do).
+     */
     void
     check(const AffineConstraints<double> &base,
           const std::vector<ContactRow>   &rows,
@@ -83,8 +95,14 @@ namespace knee_contact
                 const std::vector<ContactRow>   &rows,
                 const std::vector<bool>         &active) const override;
 
-    std::vector<Vector<double>>
-    rigid_motions() const override;
+    std::vector<double>
+    rigid_motions(const IndexSet &rows) const override;
+
+    unsigned int
+    n_rigid_motions() const override
+    {
+      return n_modes;
+    }
 
     unsigned int
     components() const override
@@ -96,12 +114,33 @@ namespace knee_contact
     static constexpr unsigned int n_modes = dim * (dim + 1) / 2;
 
   private:
+    /** A distributed mesh's communicator (free_motion() is collective
+     * there), else MPI_COMM_SELF. */
+    MPI_Comm communicator = MPI_COMM_SELF;
+    bool     distributed  = false;
+    /** The dofs this rank owns (every dof on a whole mesh), and those it
+     * knows (a distributed mesh's locally relevant ones: 1/N of the dofs
+     * and a layer, where they were every dof, 32 bytes each, on every
+     * rank until 2026-12-07). */
+    IndexSet owned, known;
+    /** By position in known: the dof's body, component and position. */
     std::vector<unsigned int> dof_body;
     std::vector<unsigned int> dof_component;
     std::vector<Point<dim>>   dof_position;
     std::vector<Point<dim>>   centre;
     std::vector<double>       size;
     std::vector<std::string>  names;
+
+    /** The position in known of @p dof, which this rank must know. */
+    std::size_t
+    at(const types::global_dof_index dof) const;
+
+    /** Add @p v times the modes' values at @p dof to @p w (the modes of
+     * the dof's body, n_modes per body); returns the body. */
+    unsigned int
+    add_modes(const types::global_dof_index dof,
+              const double                  v,
+              Vector<double>               &w) const;
   };
 } // namespace knee_contact
 

@@ -549,17 +549,15 @@ namespace knee_contact
   {
   public:
     /**
-     * On one rank, from C whole. @p modes: the rigid motions of the mesh
-     * (RigidModeCheck::rigid_motions()), AMG's near null space;
-     * @p components: the dofs per vertex (the block size of the
-     * aggregation).
+     * On one rank, from C whole. @p rigid_modes gives AMG's near null
+     * space (RigidModeCheck::rigid_motions(), on this rank's rows) and
+     * the dofs per vertex (the block size of the aggregation).
      */
-    IterativeContactSystem(const SparseMatrix<double>        &matrix,
-                           const AffineConstraints<double>   &base,
-                           const std::vector<ContactRow>     &pairs,
-                           const std::vector<Vector<double>> &modes,
-                           const unsigned int                 components,
-                           const KrylovSettings              &settings);
+    IterativeContactSystem(const SparseMatrix<double>      &matrix,
+                           const AffineConstraints<double> &base,
+                           const std::vector<ContactRow>   &pairs,
+                           const RigidModeCheck            &rigid_modes,
+                           const KrylovSettings            &settings);
 
     /**
      * Assembles C's rows: @p assemble(wanted, add) gives
@@ -576,13 +574,12 @@ namespace knee_contact
      * it holds with @p assemble_rows (this rank's, and those of the dofs
      * a constraint can hold), so that C whole is never made.
      */
-    IterativeContactSystem(const SparsityPattern             &pattern,
-                           const RowAssembly                 &assemble_rows,
-                           const AffineConstraints<double>   &base,
-                           const std::vector<ContactRow>     &pairs,
-                           const std::vector<Vector<double>> &modes,
-                           const unsigned int                 components,
-                           const KrylovSettings              &settings);
+    IterativeContactSystem(const SparsityPattern           &pattern,
+                           const RowAssembly               &assemble_rows,
+                           const AffineConstraints<double> &base,
+                           const std::vector<ContactRow>   &pairs,
+                           const RigidModeCheck            &rigid_modes,
+                           const KrylovSettings            &settings);
 
     /**
      * On a distributed mesh (DistributedMesh): @p pattern holds this
@@ -595,12 +592,11 @@ namespace knee_contact
      * every rank's, whole, as on a whole mesh).
      */
     IterativeContactSystem(const TrilinosWrappers::SparsityPattern &pattern,
-                           const RowAssembly                 &assemble_cells,
-                           const AffineConstraints<double>   &base,
-                           const std::vector<ContactRow>     &pairs,
-                           const std::vector<Vector<double>> &modes,
-                           const unsigned int                 components,
-                           const KrylovSettings              &settings);
+                           const RowAssembly               &assemble_cells,
+                           const AffineConstraints<double> &base,
+                           const std::vector<ContactRow>   &pairs,
+                           const RigidModeCheck            &rigid_modes,
+                           const KrylovSettings            &settings);
     ~IterativeContactSystem() override;
 
     void
@@ -732,8 +728,7 @@ namespace knee_contact
       const RowAssembly                       *assemble_rows,
       const AffineConstraints<double>         &base,
       const std::vector<ContactRow>           &pairs,
-      const std::vector<Vector<double>>       &modes,
-      const unsigned int                       components,
+      const RigidModeCheck                    &rigid_modes,
       const KrylovSettings                    &settings);
 
     class Implementation;
