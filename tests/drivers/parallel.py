@@ -30,9 +30,10 @@
 3. Bad input under mpirun, refused as one process refuses it: exit code
    1 and the one process's one-line error, printed once (not once per
    rank): a bad parameter, a mesh refused where it may be distributed
-   (rank 0 alone makes and checks it, the other takes its refusal) and a
-   .geo gmsh refuses (rank 0 alone runs gmsh, the others take its
-   failure); and a mesh too large where it may be distributed, refused by
+   (rank 0 alone makes and checks it, the other takes its refusal), a
+   body no constraint holds (found by all ranks together on the
+   distributed mesh) and a .geo gmsh refuses (rank 0 alone runs gmsh, the
+   others take its failure); and a mesh too large where it may be distributed, refused by
    the distributed run's estimate ("a rank on the distributed mesh"),
    said once.
 Under the sanitizers (SANITIZE = ON) the scenes whose code under mpirun is
@@ -517,6 +518,19 @@ def main():
                                    "Slave boundary id  = 1")
                      .replace("@FOLDER@", os.path.join(folder, "same")),
                      "both lie on body", failures)
+
+        # A body no constraint holds, found on the distributed mesh: the
+        # test of a free motion is collective there (each rank evaluates
+        # the rows on its own dofs, RigidModes::free_motion()), and every
+        # rank must name the same body and motion as one process.
+        refused_once(binary, folder, "a body not held",
+                     BLOCK.replace("set Boundary ids = 4\n"
+                                   "    set Type         = sliding",
+                                   "set Boundary ids = 4\n"
+                                   "    set Type         = traction\n"
+                                   "    set Value        = 0; 0")
+                     .replace("@FOLDER@", os.path.join(folder, "free")),
+                     "body 1 (block) is not held: its translation", failures)
 
         # A mesh too large for the machine where it may be distributed:
         # rank 0's check counts the distributed run (the ranks' shares,
