@@ -113,10 +113,8 @@ namespace knee_contact
 
 
   template <int dim>
-  unsigned int
-  RigidModes<dim>::add_modes(const types::global_dof_index dof,
-                             const double                  v,
-                             Vector<double>               &w) const
+  typename RigidModes<dim>::ModeValues
+  RigidModes<dim>::modes_at(const types::global_dof_index dof) const
   {
     // The translations along the axes, then the rotations about the axes
     // through the body's centre (2D: about z only), e_k x (x - centre),
@@ -124,12 +122,13 @@ namespace knee_contact
     // body; as the bodies share no dof, each is a rigid motion of every
     // body at once.
     const std::size_t    i = at(dof);
-    const unsigned int   b = dof_body[i];
+    ModeValues           values{dof_body[i], {}};
     const unsigned int   c = dof_component[i];
-    const Tensor<1, dim> r = (dof_position[i] - centre[b]) / size[b];
-    w(n_modes * b + c) += v;
+    const Tensor<1, dim> r =
+      (dof_position[i] - centre[values.body]) / size[values.body];
+    values.w[c] = 1;
     if constexpr (dim == 2)
-      w(n_modes * b + 2) += v * (c == 0 ? -r[1] : r[0]);
+      values.w[2] = c == 0 ? -r[1] : r[0];
     else
       // (e_k x r)_c = epsilon_kjc r_j: nonzero for j, k, c distinct.
       for (unsigned int k = 0; k < 3; ++k)
@@ -137,9 +136,9 @@ namespace knee_contact
           {
             const unsigned int j    = 3 - k - c;
             const double       sign = (k + 1) % 3 == j ? 1. : -1.;
-            w(n_modes * b + 3 + k) += v * sign * r[j];
+            values.w[3 + k]         = sign * r[j];
           }
-    return b;
+    return values;
   }
 
 
@@ -150,16 +149,12 @@ namespace knee_contact
   {
     const std::size_t   n = rows.n_elements();
     std::vector<double> modes(n_modes * n);
-    Vector<double>      w(n_modes * names.size());
     std::size_t         local = 0;
     for (const auto dof : rows)
       {
-        const unsigned int b = add_modes(dof, 1., w);
+        const ModeValues values = modes_at(dof);
         for (unsigned int k = 0; k < n_modes; ++k)
-          {
-            modes[k * n + local] = w(n_modes * b + k);
-            w(n_modes * b + k)   = 0;
-          }
+          modes[k * n + local] = values.w[k];
         ++local;
       }
     return modes;
@@ -187,35 +182,50 @@ namespace knee_contact
   {
     const unsigned int n_bodies = names.size(), n_all = n_modes * n_bodies;
     FullMatrix<double> gram(n_all, n_all);
-    Vector<double>     w(n_all);
+    // Adds v times the modes' values at dof to the part of its body.
+    const auto add = [this](std::vector<ModeValues>      &parts,
+                            const types::global_dof_index dof,
+                            const double                  v) {
+      const ModeValues values = modes_at(dof);
+      auto             part =
+        std::find_if(parts.begin(), parts.end(), [&](const ModeValues &p) {
+          return p.body == values.body;
+        });
+      if (part == parts.end())
+        part = parts.insert(parts.end(), ModeValues{values.body, {}});
+      for (unsigned int k = 0; k < n_modes; ++k)
+        part->w[k] += v * values.w[k];
+    };
 
     // Each homogeneous constraint row sum_d v_d x_d = 0 adds w w^T / |v|^2
-    // to the Gram matrix, w the row evaluated on the modes. A line of
-    // base on the rank that owns its dof (its entries, a vertex's
+    // to the Gram matrix, w the row evaluated on the modes, by body. A
+    // line of base on the rank that owns its dof (its entries, a vertex's
     // components or a hanging node's parents, lie on the cells around it,
     // which the rank knows); it holds one body's dofs (the bodies share
     // none), so it adds to that body's block only, and the ranks' blocks
     // are summed.
-    std::vector<double> blocks(n_bodies * n_modes * n_modes, 0.);
+    std::vector<double>     blocks(n_bodies * n_modes * n_modes, 0.);
+    std::vector<ModeValues> line_part;
     for (const auto &line : base.get_lines())
       if (owned.is_element(line.index))
         {
-          const unsigned int b    = add_modes(line.index, 1., w);
-          double             norm = 1;
+          line_part.clear();
+          add(line_part, line.index, 1.);
+          double norm = 1;
           for (const auto &[j, c] : line.entries)
             {
-              AssertThrow(add_modes(j, -c, w) == b,
-                          ExcMessage("RigidModes: a constraint of dof " +
-                                     std::to_string(line.index) +
-                                     " couples two bodies"));
+              add(line_part, j, -c);
               norm += c * c;
             }
+          AssertThrow(line_part.size() == 1,
+                      ExcMessage("RigidModes: a constraint of dof " +
+                                 std::to_string(line.index) +
+                                 " couples two bodies"));
+          const ModeValues &w = line_part[0];
           for (unsigned int i = 0; i < n_modes; ++i)
             for (unsigned int j = 0; j < n_modes; ++j)
-              blocks[(b * n_modes + i) * n_modes + j] +=
-                w(n_modes * b + i) * w(n_modes * b + j) / norm;
-          for (unsigned int k = 0; k < n_modes; ++k)
-            w(n_modes * b + k) = 0;
+              blocks[(w.body * n_modes + i) * n_modes + j] +=
+                w.w[i] * w.w[j] / norm;
         }
 
     // An active contact row: each rank evaluates it on the dofs it owns
@@ -223,29 +233,20 @@ namespace knee_contact
     // parts in the same order, so that every rank decides alike.
     struct Part
     {
-      unsigned int row, body;
-      double       w[n_modes];
+      unsigned int row;
+      ModeValues   values;
     };
-    std::vector<Part> parts;
-    std::vector<bool> touched(n_bodies, false);
+    std::vector<Part>       parts;
+    std::vector<ModeValues> row_parts;
     for (unsigned int p = 0; p < pairs.size(); ++p)
       if (active[p])
         {
+          row_parts.clear();
           for (const auto &[dof, v] : pairs[p].row)
             if (owned.is_element(dof))
-              touched[add_modes(dof, v, w)] = true;
-          for (unsigned int b = 0; b < n_bodies; ++b)
-            if (touched[b])
-              {
-                Part part{p, b, {}};
-                for (unsigned int k = 0; k < n_modes; ++k)
-                  {
-                    part.w[k]          = w(n_modes * b + k);
-                    w(n_modes * b + k) = 0;
-                  }
-                parts.push_back(part);
-                touched[b] = false;
-              }
+              add(row_parts, dof, v);
+          for (const ModeValues &values : row_parts)
+            parts.push_back({p, values});
         }
     if (distributed && !blocks.empty())
       {
@@ -266,34 +267,35 @@ namespace knee_contact
         for (unsigned int j = 0; j < n_modes; ++j)
           gram(n_modes * b + i, n_modes * b + j) =
             blocks[(b * n_modes + i) * n_modes + j];
-    std::vector<unsigned int> bodies;
     for (std::size_t first = 0; first < parts.size();)
       {
-        const unsigned int p    = parts[first].row;
-        std::size_t        last = first;
-        bodies.clear();
-        for (; last < parts.size() && parts[last].row == p; ++last)
+        // The row's parts from every rank, summed by body.
+        const unsigned int p = parts[first].row;
+        row_parts.clear();
+        for (; first < parts.size() && parts[first].row == p; ++first)
           {
-            const unsigned int b = parts[last].body;
-            if (std::find(bodies.begin(), bodies.end(), b) == bodies.end())
-              bodies.push_back(b);
-            for (unsigned int k = 0; k < n_modes; ++k)
-              w(n_modes * b + k) += parts[last].w[k];
+            const ModeValues &values = parts[first].values;
+            auto              part   = std::find_if(row_parts.begin(),
+                                     row_parts.end(),
+                                     [&](const ModeValues &r) {
+                                       return r.body == values.body;
+                                     });
+            if (part == row_parts.end())
+              row_parts.push_back(values);
+            else
+              for (unsigned int k = 0; k < n_modes; ++k)
+                part->w[k] += values.w[k];
           }
         double norm = 0;
         for (const auto &[dof, v] : pairs[p].row)
           norm += v * v;
         if (norm > 0)
-          for (const unsigned int a : bodies)
-            for (const unsigned int c : bodies)
+          for (const ModeValues &a : row_parts)
+            for (const ModeValues &c : row_parts)
               for (unsigned int i = 0; i < n_modes; ++i)
                 for (unsigned int j = 0; j < n_modes; ++j)
-                  gram(n_modes * a + i, n_modes * c + j) +=
-                    w(n_modes * a + i) * w(n_modes * c + j) / norm;
-        for (const unsigned int a : bodies)
-          for (unsigned int k = 0; k < n_modes; ++k)
-            w(n_modes * a + k) = 0;
-        first = last;
+                  gram(n_modes * a.body + i, n_modes * c.body + j) +=
+                    a.w[i] * c.w[j] / norm;
       }
 
     LAPACKFullMatrix<double> matrix(n_all);

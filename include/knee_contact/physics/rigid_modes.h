@@ -135,12 +135,16 @@ namespace knee_contact
     std::size_t
     at(const types::global_dof_index dof) const;
 
-    /** Add @p v times the modes' values at @p dof to @p w (the modes of
-     * the dof's body, n_modes per body); returns the body. */
-    unsigned int
-    add_modes(const types::global_dof_index dof,
-              const double                  v,
-              Vector<double>               &w) const;
+    /** A body's n_modes values (of the modes at a dof, or summed). */
+    struct ModeValues
+    {
+      unsigned int body;
+      double       w[n_modes];
+    };
+
+    /** The modes' values at @p dof, which this rank must know. */
+    ModeValues
+    modes_at(const types::global_dof_index dof) const;
   };
 } // namespace knee_contact
 
