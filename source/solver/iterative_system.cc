@@ -88,10 +88,7 @@ namespace knee_contact
         sparse_cholesky::condense_homogeneous(constraints, dst);
         for (const auto &line : constraints.get_lines())
           dst(line.index) = matrix.diag_element(line.index) * src(line.index);
-        ++n_products;
       }
-
-      mutable unsigned int n_products = 0;
 
     private:
       const SparseMatrix<double>      &matrix;
@@ -257,10 +254,7 @@ namespace knee_contact
               d[entry.owned] += entry.weight * r[line_local[k]];
         for (unsigned int k = 0; k < lines.size(); ++k)
           d[line_local[k]] = diagonal[k] * s[line_local[k]];
-        ++n_products;
       }
-
-      mutable unsigned int n_products = 0;
 
     private:
       /** A master of a constrained row: its local index in the ghosted
@@ -293,6 +287,21 @@ namespace knee_contact
 
   namespace
   {
+    /**
+     * What a new hierarchy costs, in CG iterations: the rules of solve()
+     * rebuild a hierarchy when the iterations it costs beyond its own rate
+     * exceed this (and give a kept one this many iterations more in its
+     * budget). A count, not the measured set-up time over the measured time
+     * of an iteration as before: the 3D knee's ratio measured 5.4 to 12.4
+     * (2.3e5 and 1e6 dofs, one to four ranks, 2026-12-07) and varied with
+     * the machine's load from run to run, so that the same scene took
+     * different hierarchies and iterations (at 1e6 dofs two ranks took
+     * three hierarchies and 260 CG iterations, 357 with two on 12-06). With
+     * a count every run of a scene on N ranks takes the same hierarchies,
+     * and every rank decides alike without a broadcast.
+     */
+    constexpr double setup_in_iterations = 10;
+
     /**
      * Trilinos ML ends the process by exit(1) when an allocation in its
      * hierarchy's set-up fails (its pr_error: "Not enough space to get a
@@ -506,7 +515,7 @@ namespace knee_contact
     // Figures.
     double       resident_at_start = 0, measured_MB = 0;
     unsigned int reference_iterations = 0;
-    double       condensation = 0, time_per_product = 0;
+    double       condensation         = 0;
     /** Several ranks: the partition's and the rows' assembly's times. */
     double       partition_time = 0, rows_assembly = 0;
     unsigned int last_iterations = 0;
@@ -562,8 +571,8 @@ namespace knee_contact
     condense();
 
     /** CG (GMRES with couplings) from @p y on the condensed system with
-     * right hand side @p b (replicated); returns the products taken. */
-    unsigned int
+     * right hand side @p b (replicated). */
+    void
     krylov(Vector<double>       &y,
            const Vector<double> &b,
            SolverControl        &control,
@@ -1100,7 +1109,7 @@ namespace knee_contact
 
 
 
-  unsigned int
+  void
   IterativeContactSystem::Implementation::krylov(Vector<double>       &y,
                                                  const Vector<double> &b,
                                                  SolverControl        &control,
@@ -1157,7 +1166,7 @@ namespace knee_contact
             SolverCG<Vector<double>> cg(control);
             cg.solve(operation, y, b, amg);
           }
-        return operation.n_products;
+        return;
       }
 
     // Several ranks: the matrix of this set is never formed.
@@ -1192,7 +1201,6 @@ namespace knee_contact
     // Every rank takes the whole solution (the rows and the results are
     // replicated).
     y = Vector<double>(y_owned);
-    return operation.n_products;
   }
 
 
@@ -1389,19 +1397,17 @@ namespace knee_contact
     d.condensation += clock.wall_time();
 
     // A hierarchy is kept while the CG iterations it costs beyond its rate
-    // on its own set (iterations per decade of the residual) stay cheaper
-    // than a new one (measured time per product against the measured
-    // set-up).
+    // on its own set (iterations per decade of the residual) stay fewer
+    // than a new one's set-up costs in CG iterations (setup_in_iterations).
     // A hierarchy of this very set is never stale (the influence solves of
     // the error bars repeat the loop's last set: measured on the 3D knee at
     // 2.3e5 dofs, the rule below rebuilt it twice there, since the loop's
     // exact last solve converges at another rate than the loose first one).
     const bool not_the_hierarchys =
       d.has_amg && (active != d.amg_active || !ties.rows.empty());
-    const bool stale = not_the_hierarchys && d.time_per_product > 0 &&
-                       (d.last_iterations - d.last_decades * d.rate_at_build) *
-                           d.time_per_product >
-                         d.totals.setup / d.totals.n_setups;
+    const bool stale = not_the_hierarchys && d.rate_at_build > 0 &&
+                       d.last_iterations - d.last_decades * d.rate_at_build >
+                         setup_in_iterations;
     // With springs, a set that moved by more than 5 % of its rows from the
     // hierarchy's gets a new one: the friction loop moves a third to all of
     // them in its first iterations (3D knee, 1.25e5 dofs: a kept hierarchy then
@@ -1427,22 +1433,22 @@ namespace knee_contact
     const bool with_springs = !d.given_springs.empty();
     const bool moved =
       with_springs && (n_changed > 0.05 * n_held || tied != d.amg_tied);
-    // The ranks measure their own times: rank 0's decision holds for all
-    // (the set-up is collective; the sets are the same on every rank).
+    // Every rank counts the same iterations and holds the same sets, so
+    // every rank decides alike (the set-up is collective).
     // The loop's exact solve of a set that is not the hierarchy's gets a
-    // new one whatever the times say (without springs): the exact solve
+    // new one whatever the rule above says (without springs): the exact solve
     // takes most of the loop's iterations, and the error bars' influence
     // solves repeat its set. The rule above decides from the last, loose
-    // solve's excess, small beside the exact solve's, so that the machine's
-    // noise decided (the 3D knee at 232 989 dofs on two ranks, 2026-12-02:
+    // solve's excess, small beside the exact solve's (when it counted
+    // measured times the machine's noise decided: the 3D knee at 232 989
+    // dofs on two ranks, 2026-12-02:
     // five runs of one hierarchy took 255 CG iterations, one that had
     // rebuilt 182, its solve 20.3 s against 32.8). Taken from what every
     // rank knows alike: no broadcast.
     const double target_relative = std::max(d.settings.tolerance, d.accuracy);
     d.exact                      = target_relative <= d.settings.tolerance;
     const bool for_exact = !with_springs && d.exact && not_the_hierarchys;
-    bool       fresh     = !d.has_amg || moved || for_exact ||
-                 Utilities::MPI::broadcast(parallel::communicator(), stale, 0);
+    bool       fresh     = !d.has_amg || moved || for_exact || stale;
     if (fresh)
       {
         // Without springs a stale hierarchy is made anew, not recomputed on
@@ -1470,26 +1476,21 @@ namespace knee_contact
     const double b_norm = std::max(b.l2_norm(), 1e-300);
 
     // With springs, a kept hierarchy gets a budget: 1.5 x the iterations a
-    // fresh one would take (its rate per decade of the residual) and those
-    // a new set-up costs. Past it the hierarchy is rebuilt and CG starts again,
-    // so that an operator that moved away from the hierarchy's costs at
-    // most about a set-up and a fresh solve more (the rule above decides
-    // from the last solve, and the friction loop changes its springs at
+    // fresh one would take (its rate per decade of the residual) and the
+    // set-up's cost in iterations. Past it the hierarchy is rebuilt and CG
+    // starts again, so that an operator that moved away from the hierarchy's
+    // costs at most about a set-up and a fresh solve more (the rule above
+    // decides from the last solve, and the friction loop changes its springs at
     // every iteration: 3D knee, 34 059 dofs, kept hierarchies took up to
     // 820 iterations where fresh ones took 100).
-    const bool budgeted = with_springs && !fresh && d.rate_at_build > 0 &&
-                          d.time_per_product > 0 && d.totals.n_setups > 0;
-    // (From rank 0's times: every rank must stop at the same iteration.)
-    const double budget_extra = Utilities::MPI::broadcast(
-      parallel::communicator(),
-      budgeted ? d.totals.setup / d.totals.n_setups / d.time_per_product : 0.,
-      0);
+    const bool   budgeted     = with_springs && !fresh && d.rate_at_build > 0;
+    const double budget_extra = budgeted ? setup_in_iterations : 0.;
     // Only a budgeted solve starts again.
     const Vector<double> start = budgeted ? y : Vector<double>();
 
     double        target = 0;
     SolverControl control(d.settings.max_iterations, 0., false, false);
-    unsigned int  n_products = 0, n_iterations = 0;
+    unsigned int  n_iterations = 0;
     double        rebuild_time = 0;
     clock.restart();
     const auto failed = [&](const SolverControl::NoConvergence &failure) {
@@ -1507,14 +1508,14 @@ namespace knee_contact
     };
     try
       {
-        n_products = d.krylov(y,
-                              b,
-                              control,
-                              target,
-                              b_norm,
-                              target_relative,
-                              budgeted ? d.rate_at_build : 0.,
-                              budget_extra);
+        d.krylov(y,
+                 b,
+                 control,
+                 target,
+                 b_norm,
+                 target_relative,
+                 budgeted ? d.rate_at_build : 0.,
+                 budget_extra);
       }
     catch (const SolverControl::NoConvergence &failure)
       {
@@ -1527,7 +1528,6 @@ namespace knee_contact
         // took 150).
         y            = start;
         n_iterations = failure.last_step;
-        n_products   = failure.last_step + 1;
         Timer rebuild;
         d.build_amg(/*anew=*/true);
         d.amg_active = active;
@@ -1537,8 +1537,7 @@ namespace knee_contact
         control.set_max_steps(d.settings.max_iterations - n_iterations);
         try
           {
-            n_products +=
-              d.krylov(y, b, control, target, b_norm, target_relative, 0, 0);
+            d.krylov(y, b, control, target, b_norm, target_relative, 0, 0);
           }
         catch (const SolverControl::NoConvergence &failure)
           {
@@ -1547,8 +1546,7 @@ namespace knee_contact
       }
     const double time = clock.wall_time() - rebuild_time;
     d.totals.krylov += time;
-    d.time_per_product = time / std::max<unsigned int>(1, n_products);
-    d.last_iterations  = n_iterations + control.last_step();
+    d.last_iterations = n_iterations + control.last_step();
     d.last_decades =
       std::log10(std::max(control.initial_value(), 1e-300) /
                  std::max(control.last_value(),
