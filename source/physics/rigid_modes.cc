@@ -182,12 +182,12 @@ namespace knee_contact
   {
     const unsigned int n_bodies = names.size(), n_all = n_modes * n_bodies;
     FullMatrix<double> gram(n_all, n_all);
-    // Adds v times the modes' values at dof to the part of its body.
-    const auto add = [this](std::vector<ModeValues>      &parts,
-                            const types::global_dof_index dof,
-                            const double                  v) {
-      const ModeValues values = modes_at(dof);
-      auto             part =
+    // Adds v times values to the part of their body (a list of a few
+    // bodies, each once).
+    const auto add_values = [](std::vector<ModeValues> &parts,
+                               const ModeValues        &values,
+                               const double             v) {
+      auto part =
         std::find_if(parts.begin(), parts.end(), [&](const ModeValues &p) {
           return p.body == values.body;
         });
@@ -195,6 +195,12 @@ namespace knee_contact
         part = parts.insert(parts.end(), ModeValues{values.body, {}});
       for (unsigned int k = 0; k < n_modes; ++k)
         part->w[k] += v * values.w[k];
+    };
+    // v times the modes' values at dof.
+    const auto add = [&](std::vector<ModeValues>      &parts,
+                         const types::global_dof_index dof,
+                         const double                  v) {
+      add_values(parts, modes_at(dof), v);
     };
 
     // Each homogeneous constraint row sum_d v_d x_d = 0 adds w w^T / |v|^2
@@ -273,19 +279,7 @@ namespace knee_contact
         const unsigned int p = parts[first].row;
         row_parts.clear();
         for (; first < parts.size() && parts[first].row == p; ++first)
-          {
-            const ModeValues &values = parts[first].values;
-            auto              part   = std::find_if(row_parts.begin(),
-                                     row_parts.end(),
-                                     [&](const ModeValues &r) {
-                                       return r.body == values.body;
-                                     });
-            if (part == row_parts.end())
-              row_parts.push_back(values);
-            else
-              for (unsigned int k = 0; k < n_modes; ++k)
-                part->w[k] += values.w[k];
-          }
+          add_values(row_parts, parts[first].values, 1.);
         double norm = 0;
         for (const auto &[dof, v] : pairs[p].row)
           norm += v * v;
