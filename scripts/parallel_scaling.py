@@ -11,10 +11,17 @@ cannot). Each run writes its results into a folder of its own
 (output/scaling/<scene>_<N>_<k>) and the table is read from its
 summary.json: the whole run, the contact solve, the Krylov and AMG set-up
 times of the iterative path, CG iterations, the peak resident memory of
-rank 0 (every rank holds about the same) and the largest relative
-difference of the contact forces and peak pressures from the one-process
-run. Times are the median over --repeat runs; the ratios are of medians
-measured in this one invocation (the machine is noisy).
+rank 0 and the largest relative difference of the contact forces and
+peak pressures from the one-process run. Times are the median over
+--repeat runs; the ratios are of medians measured in this one invocation
+(the machine is noisy).
+
+A second table gives the largest rank's memory against issue 38's bound,
+1.2 x (the first N's peak / N + the contact rows every rank holds): its
+resident peak as the kernel keeps it (VmHWM, summary.json) and, sampled
+every 0.5 s from /proc, its resident set (Rss) and proportional share
+(Pss: a page that k ranks map, the libraries' code say, counted 1/k in
+each).
 
 With --repeat R > 1 the runs go in R rounds, each round one run of every
 N (1, 2, 4, 1, 2, 4, ...), so that a slow hour of the machine slows every
@@ -40,14 +47,77 @@ import re
 import statistics
 import subprocess
 import sys
+import threading
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import scaling_model  # noqa: E402
 
 
+class MemorySampler:
+    """Every 0.5 s, the resident set (Rss) and proportional share (Pss) of
+    each process of @p binary started under the process @p pid (mpirun's
+    ranks, or the one process), from /proc/<pid>/smaps_rollup: the peaks
+    of each (peaks()). Pss counts a page that k processes map 1/k to
+    each (the libraries' code, mapped by every rank: one copy in the
+    machine's memory); Rss counts it whole in every rank. The kernel keeps
+    no peak of Pss (VmHWM is Rss's), hence the sampling."""
+
+    def __init__(self, pid, binary):
+        self.pid, self.binary = pid, os.path.realpath(binary)
+        self.rss, self.pss = {}, {}
+        self.done = threading.Event()
+        self.thread = threading.Thread(target=self.sample, daemon=True)
+        self.thread.start()
+
+    def processes(self):
+        """The processes of the binary in the tree under self.pid."""
+        children = {}
+        for entry in os.listdir("/proc"):
+            if not entry.isdigit():
+                continue
+            try:
+                with open("/proc/%s/stat" % entry) as f:
+                    parent = int(f.read().rsplit(")", 1)[1].split()[1])
+            except (OSError, ValueError, IndexError):
+                continue
+            children.setdefault(parent, []).append(int(entry))
+        tree, found = [self.pid], []
+        while tree:
+            pid = tree.pop()
+            tree.extend(children.get(pid, []))
+            try:
+                if os.path.realpath("/proc/%d/exe" % pid) == self.binary:
+                    found.append(pid)
+            except OSError:
+                pass
+        return found
+
+    def sample(self):
+        while not self.done.wait(0.5):
+            for pid in self.processes():
+                try:
+                    with open("/proc/%d/smaps_rollup" % pid) as f:
+                        fields = dict(line.split()[:2] for line in f
+                                      if line.startswith(("Rss:", "Pss:")))
+                except (OSError, ValueError):
+                    continue
+                for key, peaks in (("Rss:", self.rss), ("Pss:", self.pss)):
+                    if key in fields:
+                        peaks[pid] = max(peaks.get(pid, 0),
+                                         int(fields[key]) / 1024.)
+
+    def peaks(self):
+        """The largest process's sampled Rss and Pss peaks [MB]."""
+        self.done.set()
+        self.thread.join()
+        return (max(self.rss.values(), default=0.),
+                max(self.pss.values(), default=0.))
+
+
 def run(binary, scene_text, folder, ranks):
-    """One run; its summary.json and wall time."""
+    """One run; its summary.json (with the sampled peaks added as
+    "sampled_rss_MB" and "sampled_pss_MB") and wall time."""
     os.makedirs(folder, exist_ok=True)
     scene = folder + ".prm"
     with open(scene, "w") as f:
@@ -58,14 +128,19 @@ def run(binary, scene_text, folder, ranks):
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1",
                OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     start = time.monotonic()
-    result = subprocess.run(command, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, env=env)
+    process = subprocess.Popen(command, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True, env=env)
+    sampler = MemorySampler(process.pid, binary)
+    _, errors = process.communicate()
     seconds = time.monotonic() - start
-    if result.returncode != 0:
+    rss, pss = sampler.peaks()
+    if process.returncode != 0:
         sys.exit("%s on %d ranks failed (%d): %s" %
-                 (scene, ranks, result.returncode, result.stderr[-2000:]))
+                 (scene, ranks, process.returncode, errors[-2000:]))
     with open(os.path.join(folder, "summary.json")) as f:
-        return json.load(f), seconds
+        summary = json.load(f)
+    summary["sampled_rss_MB"], summary["sampled_pss_MB"] = rss, pss
+    return summary, seconds
 
 
 PROBE = """
@@ -115,6 +190,26 @@ def print_rounds(ranks, rounds):
                     "%d / %d %.2f" % (ranks[0], n, statistics.median(
                         row[i] for row in chosen))
                     for i, n in enumerate(ranks[1:]))))
+
+
+def print_memory(rows):
+    """The largest rank's memory against issue 38's bound, 1.2 x (the first
+    row's peak / N + the rows every rank holds whole), in the kernel's
+    resident peak (VmHWM, summary.json) and in the sampled Rss and Pss
+    peaks (MemorySampler)."""
+    base = rows[0]
+    print("\n| ranks | largest rank's peak (VmHWM) [MB] | sampled Rss peak "
+          "[MB] | sampled Pss peak [MB] | replicated rows [MB] | bound 1.2 x "
+          "(%d's / N + replicated) [MB] | VmHWM / bound | Pss / bound |"
+          % base["ranks"])
+    print("|" + "---|" * 8)
+    for row in rows:
+        bound = 1.2 * (base["largest_peak"] * base["ranks"] / row["ranks"] +
+                       row["replicated"])
+        print("| %d | %.0f | %.0f | %.0f | %.1f | %.0f | %.3f | %.3f |" % (
+            row["ranks"], row["largest_peak"], row["sampled_rss"],
+            row["sampled_pss"], row["replicated"], bound,
+            row["largest_peak"] / bound, row["sampled_pss"] / bound))
 
 
 def contact_numbers(summary):
@@ -231,6 +326,13 @@ def main():
             "part": median(lambda s: s["wall_time"].get("mesh: part", 0)),
             "mesh_peak": median(
                 lambda s: s["solver"].get("mesh_peak_memory_MB", 0)),
+            "largest_peak": median(lambda s: s["solver"].get(
+                "largest_rank_peak_memory_MB",
+                s["solver"].get("peak_memory_MB", 0))),
+            "replicated": median(
+                lambda s: s["solver"].get("replicated_rows_MB", 0)),
+            "sampled_rss": median(lambda s: s["sampled_rss_MB"]),
+            "sampled_pss": median(lambda s: s["sampled_pss_MB"]),
             "difference": difference})
 
     print("| ranks | DoFs | path | whole run [s] | solve [s] | Krylov [s] "
@@ -247,6 +349,7 @@ def main():
                   base["run"] / row["run"],
                   base["solve"] / max(row["solve"], 1e-9), row["estimate"],
                   row["path_measured"], row["peak"], row["difference"]))
+    print_memory(rows)
     if args.repeat > 1:
         print_rounds(args.ranks, rounds)
     if args.model:

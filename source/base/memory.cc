@@ -3,6 +3,9 @@
 
 #include <dlfcn.h>
 #include <sys/resource.h>
+#ifdef __GLIBC__
+#  include <malloc.h>
+#endif
 
 #include <algorithm>
 #include <cmath>
@@ -107,6 +110,16 @@ namespace knee_contact
     peak_resident_MB()
     {
       return read_field("/proc/self/status", "VmHWM:", 1. / 1024.);
+    }
+
+
+
+    void
+    return_free_heap()
+    {
+#ifdef __GLIBC__
+      malloc_trim(0);
+#endif
     }
 
 

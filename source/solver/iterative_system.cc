@@ -1,4 +1,5 @@
 #include <knee_contact/base/interruption.h>
+#include <knee_contact/base/memory.h>
 #include <knee_contact/base/parallel.h>
 #include <knee_contact/solver/active_set.h>
 #include <knee_contact/solver/contact_system.h>
@@ -34,9 +35,6 @@
 #include <map>
 #include <memory>
 #include <sstream>
-#ifdef __GLIBC__
-#  include <malloc.h>
-#endif
 
 namespace knee_contact
 {
@@ -301,21 +299,6 @@ namespace knee_contact
      * and every rank decides alike without a broadcast.
      */
     constexpr double setup_in_iterations = 10;
-
-    /**
-     * Gives the heap's free pages back to the system (glibc's malloc_trim;
-     * elsewhere nothing). glibc keeps what a phase freed (rank 0's whole
-     * mesh, the set-up's temporaries, an old hierarchy) and a new
-     * hierarchy's blocks do not fit into it: each rebuild raised a rank's
-     * resident set by 10 to 90 MB at 1e6 dofs.
-     */
-    void
-    return_free_heap()
-    {
-#ifdef __GLIBC__
-      malloc_trim(0);
-#endif
-    }
 
     /**
      * Trilinos ML ends the process by exit(1) when an allocation in its
@@ -632,7 +615,7 @@ namespace knee_contact
     amg.clear();
     // The heap's free pages go back first (the largest of four ranks'
     // peaks at 1e6 dofs 1 253-1 271 -> 1 201-1 215 MB, doc/parallel.md).
-    return_free_heap();
+    memory::return_free_heap();
     condense();
     // This rank's part of the null space, zero on the constrained dofs:
     // their rows are decoupled.
@@ -1286,7 +1269,7 @@ namespace knee_contact
     // The heap freed before is given back first, as the first hierarchy
     // does (build_amg()): else the path's measured memory was that less,
     // -68 MB on four ranks at 1e6 dofs against an estimate of 642.
-    return_free_heap();
+    memory::return_free_heap();
     const double resident = iterative::resident_MB();
     implementation        = std::make_unique<Implementation>(pattern,
                                                       distributed_pattern,

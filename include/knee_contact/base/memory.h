@@ -31,6 +31,17 @@ namespace knee_contact
     double
     peak_resident_MB();
 
+    /**
+     * Gives the heap's free pages back to the system (glibc's malloc_trim;
+     * elsewhere nothing). glibc keeps what a phase freed (rank 0's whole
+     * mesh, the set-up's temporaries, an old hierarchy, the solve's
+     * vectors) for what comes next, and the next phase's blocks often do
+     * not fit into it: each AMG rebuild raised a rank's resident set by 10
+     * to 90 MB at 1e6 dofs (doc/parallel.md).
+     */
+    void
+    return_free_heap();
+
     /** "123 MB". */
     std::string
     megabytes(double bytes);
