@@ -184,7 +184,7 @@ namespace knee_contact
             // influences and recoveries did not fit into it and set the
             // peak of one process and of every rank on four at 1e6 dofs
             // (one process 3 834 -> 3 567 MB with both trims, the end of
-            // the run on four ranks 1 178-1 202 -> 1 085-1 097 a rank;
+            // the run on four ranks 1 146-1 202 -> 1 077-1 097 a rank;
             // doc/parallel.md).
             memory::return_free_heap();
             record.recovered_energy_error =
