@@ -516,12 +516,14 @@ namespace knee_contact
         // The bodies and their names are the whole mesh's (distribute()).
         dof_handler.reinit(distributed->triangulation);
         dof_handler.distribute_dofs(*fe);
+        elements::renumber_vertex_wise(dof_handler);
         body_of_cell = distributed->body_of_cell;
       }
     else
       {
         dof_handler.reinit(triangulation);
         dof_handler.distribute_dofs(*fe);
+        elements::renumber_vertex_wise(dof_handler);
         body_of_cell = compute_body_ids(triangulation, n_bodies);
         name_bodies();
       }

@@ -320,14 +320,28 @@ namespace knee_contact
             body           = b;
           }
       }
+    // An eigenvector's sign is arbitrary (the round-off of the dofs'
+    // order decides it): the mode is shown with its largest coefficient
+    // positive (the first of those equal to 1e-12), so that one scene gives
+    // one message.
+    double sign = 1, largest_coefficient = 0;
+    for (unsigned int k = 0; k < n_modes; ++k)
+      {
+        const double v = eigenvectors(n_modes * body + k, 0);
+        if (std::abs(v) > largest_coefficient + 1e-12)
+          {
+            largest_coefficient = std::abs(v);
+            sign                = v < 0 ? -1. : 1.;
+          }
+      }
     // u(x) = t + omega x (x - centre), omega along z in 2D.
     Tensor<1, dim> t;
     Tensor<1, 3>   omega;
     for (unsigned int d = 0; d < dim; ++d)
-      t[d] = eigenvectors(n_modes * body + d, 0);
+      t[d] = sign * eigenvectors(n_modes * body + d, 0);
     for (unsigned int k = 0; k < n_modes - dim; ++k)
       omega[dim == 2 ? 2 : k] =
-        eigenvectors(n_modes * body + dim + k, 0) / size[body];
+        sign * eigenvectors(n_modes * body + dim + k, 0) / size[body];
     std::ostringstream motion;
     motion.precision(4);
     // Components at round-off of a unit direction are shown as 0.

@@ -44,6 +44,18 @@ namespace knee_contact
     displacement_element(const ReferenceCell &kind);
 
     /**
+     * Renumber @p dof_handler's dofs (its locally owned ones, within the
+     * same indices) vertex by vertex, the vertices in Cuthill-McKee order
+     * of the graph of their cells, each vertex's dim components kept
+     * together and in order (the node blocks Trilinos ML's "PDE
+     * equations" assumes). The order deal.II's distribute_dofs() leaves is
+     * the mesh file's cell order, which a mesher need not keep local.
+     */
+    template <int dim>
+    void
+    renumber_vertex_wise(DoFHandler<dim> &dof_handler);
+
+    /**
      * "Q1" or "P1", as in summary.json.
      */
     std::string
