@@ -44,11 +44,10 @@ namespace knee_contact
       // graph of every dof pair took 11.7 s at 1e6 dofs, this one 2.7 s
       // (the vertices' graph has a ninth of the entries). Measured on the
       // 3D knee at 1e6 dofs against the file's order (doc/parallel.md): a
-      // CG iteration 0.79 -> 0.51 s on one process, 0.46 -> 0.36 on two
-      // ranks (the vectors' and the matrix's accesses near each other),
-      // CG iterations 482 -> 413 and 260 -> 258 (ML aggregates in row
-      // order); at 2.3e5 dofs the iterations went the other way, 185 ->
-      // 217 and 196 -> 213.
+      // CG iteration 0.79 -> 0.46 s on one process (the vectors' and the
+      // matrix's accesses near each other), CG iterations 482 -> 387 on
+      // one process and 260 -> 250 on two ranks (ML aggregates in row
+      // order); at 2.3e5 dofs 185 -> 222 and 196 -> 189.
       const IndexSet &owned = dof_handler.locally_owned_dofs();
       AssertThrow(dof_handler.get_fe().n_dofs_per_cell() ==
                     dof_handler.get_fe().n_dofs_per_vertex() *
@@ -91,11 +90,14 @@ namespace knee_contact
       // renumber_dofs(), which is collective.)
       if (n_local > 0)
         SparsityTools::reorder_Cuthill_McKee(graph, order);
-      // order[k]: the new place of local vertex k. The vertices' components
-      // take this rank's indices in that order.
+      // order[k]: the place of local vertex k in Cuthill-McKee order. The
+      // vertices' components take this rank's indices in the reverse of
+      // that order (the textbook's choice; measured, doc/parallel.md: CG
+      // iterations at 1e6 dofs 387 against Cuthill-McKee's 413 on one
+      // process, 250 against 258 on two ranks).
       std::vector<unsigned int> at(n_local);
       for (unsigned int k = 0; k < n_local; ++k)
-        at[order[k]] = k;
+        at[n_local - 1 - order[k]] = k;
       AssertThrow(dofs.size() == owned.n_elements(), ExcInternalError());
       std::vector<types::global_dof_index> new_numbers(owned.n_elements());
       types::global_dof_index              next = 0;

@@ -45,8 +45,8 @@ namespace knee_contact
 
     /**
      * Renumber @p dof_handler's dofs (its locally owned ones, within the
-     * same indices) vertex by vertex, the vertices in Cuthill-McKee order
-     * of the graph of their cells, each vertex's dim components kept
+     * same indices) vertex by vertex, the vertices in reverse Cuthill-McKee
+     * order of the graph of their cells, each vertex's dim components kept
      * together and in order (the node blocks Trilinos ML's "PDE
      * equations" assumes). The order deal.II's distribute_dofs() leaves is
      * the mesh file's cell order, which a mesher need not keep local.
