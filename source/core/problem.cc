@@ -515,18 +515,16 @@ namespace knee_contact
       {
         // The bodies and their names are the whole mesh's (distribute()).
         dof_handler.reinit(distributed->triangulation);
-        dof_handler.distribute_dofs(*fe);
-        elements::renumber_vertex_wise(dof_handler);
         body_of_cell = distributed->body_of_cell;
       }
     else
       {
         dof_handler.reinit(triangulation);
-        dof_handler.distribute_dofs(*fe);
-        elements::renumber_vertex_wise(dof_handler);
         body_of_cell = compute_body_ids(triangulation, n_bodies);
         name_bodies();
       }
+    dof_handler.distribute_dofs(*fe);
+    elements::renumber_vertex_wise(dof_handler);
 
     boundary_conditions.make_constraints(dof_handler, constraints);
     contact_pairs =

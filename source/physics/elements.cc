@@ -71,6 +71,10 @@ namespace knee_contact
                 for (unsigned int c = 0; c < components; ++c)
                   dofs.push_back(cell->vertex_dof_index(v, c));
               }
+      // The graph of the vertices that share a cell (its size is known only
+      // now, hence a second pass): a ninth of the entries of the dofs'
+      // sparsity pattern, freed before that is made, so it never sets the
+      // run's peak.
       const unsigned int        n_local = dofs.size() / components;
       DynamicSparsityPattern    graph(n_local);
       std::vector<unsigned int> mine;

@@ -322,7 +322,7 @@ namespace knee_contact
       }
     // An eigenvector's sign is arbitrary (the round-off of the dofs'
     // order decides it): the mode is shown with its largest coefficient
-    // positive (the first of those equal to 1e-12), so that one scene gives
+    // positive (of those equal to 1e-12, the first), so that one scene gives
     // one message.
     double sign = 1, largest_coefficient = 0;
     for (unsigned int k = 0; k < n_modes; ++k)
